@@ -1,0 +1,15 @@
+//! Geometry shared by every stage: boxes, triangles, the one watertight segment/triangle test and the
+//! exact triangle/box overlap test.
+//!
+//! SPEC §3 (octree assignment needs the triangle/box test) and §5 (one watertight test everywhere, so
+//! every visibility mode answers the same shadow ray identically).
+
+pub mod aabb;
+pub mod ray_triangle;
+pub mod tri_box;
+pub mod triangle;
+
+pub use aabb::Aabb;
+pub use ray_triangle::RayTest;
+pub use tri_box::triangle_overlaps_box;
+pub use triangle::Triangle;

@@ -1,0 +1,147 @@
+//! Area lights (SPEC §1): planar convex polygons emitting constant radiance `L_e` into the half-space
+//! their normal points to. The polygon's vertices are the light's "coordinates" used by the P-LIE
+//! construction; sampling is uniform over its area (SPEC §2).
+
+use glam::{Vec2, Vec3};
+use serde::{Deserialize, Serialize};
+
+use super::TriId;
+use crate::error::{Error, Result};
+
+/// A one-sided convex polygonal area light.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Light {
+    /// Vertices, counter-clockwise seen from the side the light emits to.
+    pub vertices: Vec<Vec3>,
+    /// Unit normal of the emitting side.
+    pub normal: Vec3,
+    /// Area.
+    pub area: f32,
+    /// Emitted radiance `L_e`, linear RGB.
+    pub radiance: Vec3,
+    /// The scene triangles that make up the light; shadow rays toward this light ignore them.
+    pub triangles: Vec<TriId>,
+    /// Cumulative area fractions of the fan triangles `(v0, v_i, v_i+1)`, for sampling.
+    fan_cdf: Vec<f32>,
+    /// True if the polygon is a parallelogram, sampled by the bilinear map (keeps N-rooks strata).
+    parallelogram: bool,
+}
+
+impl Light {
+    /// A light from a convex polygon (counter-clockwise around the emitting side) and its radiance.
+    /// Fails on fewer than 3 vertices, non-finite values, zero area, a non-planar or non-convex polygon,
+    /// or a radiance that is negative, non-finite or zero.
+    pub fn new(vertices: Vec<Vec3>, radiance: Vec3, triangles: Vec<TriId>) -> Result<Light> {
+        let bad = |m: &str| Error::InvalidScene(format!("light with vertices {vertices:?}: {m}"));
+        if vertices.len() < 3 {
+            return Err(bad("fewer than 3 vertices"));
+        }
+        if !vertices.iter().all(|v| v.is_finite()) {
+            return Err(bad("non-finite coordinate"));
+        }
+        if !radiance.is_finite() || radiance.min_element() < 0.0 || radiance.max_element() <= 0.0 {
+            return Err(bad(&format!("radiance {radiance} must be finite, non-negative and not zero")));
+        }
+        // Newell normal: robust for any planar polygon.
+        let mut n = Vec3::ZERO;
+        for (i, a) in vertices.iter().enumerate() {
+            n += a.cross(vertices[(i + 1) % vertices.len()]);
+        }
+        let area = 0.5 * n.length();
+        let size = extent(&vertices);
+        if !(area > 1e-10 * size * size) {
+            return Err(bad("zero area"));
+        }
+        let normal = n / (2.0 * area);
+        for v in &vertices {
+            if (*v - vertices[0]).dot(normal).abs() > 1e-4 * size {
+                return Err(bad("vertices are not coplanar"));
+            }
+        }
+        let k = vertices.len();
+        for i in 0..k {
+            let (a, b, c) = (vertices[i], vertices[(i + 1) % k], vertices[(i + 2) % k]);
+            if (b - a).cross(c - b).dot(normal) < -1e-6 * size * size {
+                return Err(bad("polygon is not convex"));
+            }
+        }
+        let mut fan_cdf = Vec::with_capacity(k - 2);
+        let mut acc = 0.0;
+        for i in 1..k - 1 {
+            acc += 0.5 * (vertices[i] - vertices[0]).cross(vertices[i + 1] - vertices[0]).length();
+            fan_cdf.push(acc);
+        }
+        for c in &mut fan_cdf {
+            *c /= acc;
+        }
+        let parallelogram =
+            k == 4 && ((vertices[0] + vertices[2]) - (vertices[1] + vertices[3])).length() <= 1e-5 * size;
+        Ok(Light { vertices, normal, area, radiance, triangles, fan_cdf, parallelogram })
+    }
+
+    /// Maps `u` in the unit square to a point on the light, uniformly by area: a stratified set of `u`
+    /// (N-rooks) stays stratified over the light.
+    pub fn sample(&self, u: Vec2) -> Vec3 {
+        let v = &self.vertices;
+        if self.parallelogram {
+            return v[0] + (v[1] - v[0]) * u.x + (v[3] - v[0]) * u.y;
+        }
+        // Pick a fan triangle by area with u.x, then reuse the remainder of u.x.
+        let i = self.fan_cdf.partition_point(|&c| c < u.x).min(self.fan_cdf.len() - 1);
+        let lo = if i == 0 { 0.0 } else { self.fan_cdf[i - 1] };
+        let hi = self.fan_cdf[i];
+        let ux = if hi > lo { ((u.x - lo) / (hi - lo)).clamp(0.0, 1.0) } else { 0.5 };
+        let s = ux.sqrt();
+        let (b1, b2) = (s * (1.0 - u.y), s * u.y);
+        v[0] + (v[i + 1] - v[0]) * b1 + (v[i + 2] - v[0]) * b2
+    }
+
+    /// Centroid of the vertices.
+    pub fn center(&self) -> Vec3 {
+        self.vertices.iter().copied().sum::<Vec3>() / self.vertices.len() as f32
+    }
+}
+
+/// Largest extent of a point set, as a length scale for tolerances.
+fn extent(p: &[Vec3]) -> f32 {
+    crate::geometry::Aabb::from_points(p).size().max_element().max(f32::MIN_POSITIVE)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn square() -> Vec<Vec3> {
+        vec![Vec3::new(0.0, 0.0, 0.0), Vec3::new(0.0, 0.0, 1.0), Vec3::new(1.0, 0.0, 1.0), Vec3::new(1.0, 0.0, 0.0)]
+    }
+
+    #[test]
+    fn square_light_normal_area_and_samples() {
+        let l = Light::new(square(), Vec3::ONE, vec![]).unwrap();
+        assert!((l.area - 1.0).abs() < 1e-6);
+        assert!((l.normal - Vec3::Y).length() < 1e-6);
+        let p = l.sample(Vec2::new(0.25, 0.75));
+        assert!(p.y.abs() < 1e-7 && (0.0..=1.0).contains(&p.x) && (0.0..=1.0).contains(&p.z));
+    }
+
+    #[test]
+    fn triangle_light_samples_stay_inside() {
+        let l = Light::new(vec![Vec3::ZERO, Vec3::X, Vec3::Y], Vec3::ONE, vec![]).unwrap();
+        for i in 0..10 {
+            for j in 0..10 {
+                let p = l.sample(Vec2::new(i as f32 / 9.0, j as f32 / 9.0));
+                assert!(p.x >= -1e-6 && p.y >= -1e-6 && p.x + p.y <= 1.0 + 1e-6);
+            }
+        }
+    }
+
+    #[test]
+    fn rejects_bad_lights() {
+        assert!(Light::new(vec![Vec3::ZERO, Vec3::X, Vec3::X * 2.0], Vec3::ONE, vec![]).is_err());
+        assert!(Light::new(square(), Vec3::ZERO, vec![]).is_err());
+        assert!(Light::new(square(), Vec3::splat(f32::NAN), vec![]).is_err());
+        let mut s = square();
+        s.swap(1, 2); // bow-tie
+        assert!(Light::new(s, Vec3::ONE, vec![]).is_err());
+    }
+}

@@ -1,0 +1,4 @@
+//! BVH visibility (work in progress).
+
+/// BVH.
+pub struct BvhVisibility;

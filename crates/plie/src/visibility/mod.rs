@@ -1,0 +1,23 @@
+//! Visibility: does anything block the segment from a shaded point `x` to a light sample `y`?
+//! (SPEC §5.) Every mode implements [`Visibility`]; all of them must answer exactly as [`Brute`] does,
+//! which they do by testing candidates with the one shared [`blocks`] predicate and pruning only
+//! conservatively.
+
+pub mod brute;
+pub mod bvh;
+pub mod mode;
+pub mod octree;
+pub mod query;
+
+pub use brute::Brute;
+pub use bvh::BvhVisibility;
+pub use mode::Mode;
+pub use octree::OctreeVisibility;
+pub use query::{blocks, QueryCtx, QueryStats, ShadowRay};
+
+/// A visibility method: answers shadow-ray queries exactly.
+pub trait Visibility: Sync {
+    /// True if some triangle other than the ray's own (its origin triangle and the target light's
+    /// triangles) intersects the open segment. `ctx` is the calling thread's scratch space and counters.
+    fn occluded(&self, ray: &ShadowRay, ctx: &mut QueryCtx) -> bool;
+}

@@ -1,0 +1,46 @@
+//! The visibility modes a user can choose (`--visibility`).
+
+use std::fmt;
+use std::str::FromStr;
+
+/// A visibility method.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Mode {
+    /// Every triangle: the reference.
+    Brute,
+    /// SPEC §5 mode (a): walk the octree leaves along the segment.
+    Octree,
+    /// A modern BVH (the peer).
+    Bvh,
+}
+
+impl Mode {
+    /// Every mode, for tests that compare them all.
+    pub const ALL: [Mode; 3] = [Mode::Brute, Mode::Octree, Mode::Bvh];
+
+    /// The name used on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            Mode::Brute => "brute",
+            Mode::Octree => "octree",
+            Mode::Bvh => "bvh",
+        }
+    }
+}
+
+impl fmt::Display for Mode {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl FromStr for Mode {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Mode, String> {
+        Mode::ALL.into_iter().find(|m| m.name() == s).ok_or_else(|| {
+            let names: Vec<_> = Mode::ALL.iter().map(|m| m.name()).collect();
+            format!("unknown visibility mode '{s}' (choose from {})", names.join(", "))
+        })
+    }
+}

@@ -1,0 +1,112 @@
+//! The shadow-ray query shared by all modes, the per-thread query context (counters and the
+//! de-duplication stamps of SPEC §3), and [`blocks`], the one predicate that decides whether a triangle
+//! blocks a shadow ray.
+
+use glam::Vec3;
+
+use crate::geometry::RayTest;
+use crate::octree::LeafId;
+use crate::scene::{LightId, Scene, TriId};
+
+/// The open parameter range of a shadow segment `x + t (y - x)`: `(SEGMENT_EPS, 1 - SEGMENT_EPS)`.
+/// Keeps the shaded surface's neighbours and whatever touches the light sample from counting.
+pub const SEGMENT_EPS: f32 = 1e-4;
+
+/// A shadow ray from a shaded point to a sample on a light.
+#[derive(Clone, Copy, Debug)]
+pub struct ShadowRay {
+    /// The segment, prepared for the watertight test; `t` runs from 0 at `x` to 1 at `y`.
+    pub test: RayTest,
+    /// The light sampled.
+    pub light: LightId,
+    /// The triangle `x` lies on (never counts as a blocker).
+    pub origin_tri: TriId,
+    /// The octree leaf containing `x`, when known (from the hit buffer).
+    pub leaf: Option<LeafId>,
+}
+
+impl ShadowRay {
+    /// The segment from `x` on `origin_tri` to `y` on `light`.
+    pub fn new(x: Vec3, y: Vec3, light: LightId, origin_tri: TriId, leaf: Option<LeafId>) -> ShadowRay {
+        ShadowRay { test: RayTest::new(x, y - x, SEGMENT_EPS, 1.0 - SEGMENT_EPS), light, origin_tri, leaf }
+    }
+
+    /// Start point `x`.
+    pub fn origin(&self) -> Vec3 {
+        self.test.origin
+    }
+
+    /// End point `y`.
+    pub fn end(&self) -> Vec3 {
+        self.test.origin + self.test.dir
+    }
+}
+
+/// Counters of one thread's queries, summed over threads at the end.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
+pub struct QueryStats {
+    /// Shadow rays answered.
+    pub shadow_rays: u64,
+    /// Shadow rays found occluded.
+    pub occluded: u64,
+    /// Watertight triangle tests run.
+    pub triangle_tests: u64,
+}
+
+impl std::ops::AddAssign for QueryStats {
+    fn add_assign(&mut self, o: QueryStats) {
+        self.shadow_rays += o.shadow_rays;
+        self.occluded += o.occluded;
+        self.triangle_tests += o.triangle_tests;
+    }
+}
+
+/// Per-thread scratch space for queries: counters and the stamp array that makes sure a triangle met
+/// in several leaves is tested once per query.
+#[derive(Clone, Debug, Default)]
+pub struct QueryCtx {
+    /// Counters.
+    pub stats: QueryStats,
+    stamps: Vec<u32>,
+    stamp: u32,
+}
+
+impl QueryCtx {
+    /// A context for a scene with `triangles` triangles.
+    pub fn new(triangles: usize) -> QueryCtx {
+        QueryCtx { stats: QueryStats::default(), stamps: vec![0; triangles], stamp: 0 }
+    }
+
+    /// Starts a new query: every triangle counts as unvisited again.
+    #[inline]
+    pub fn begin_query(&mut self) {
+        self.stamp = self.stamp.wrapping_add(1);
+        if self.stamp == 0 {
+            self.stamps.fill(0);
+            self.stamp = 1;
+        }
+    }
+
+    /// True the first time `t` is seen in the current query.
+    #[inline]
+    pub fn first_visit(&mut self, t: TriId) -> bool {
+        let s = &mut self.stamps[t.idx()];
+        if *s == self.stamp {
+            false
+        } else {
+            *s = self.stamp;
+            true
+        }
+    }
+}
+
+/// The one blocker predicate: true if triangle `t` blocks `ray`. The ray's origin triangle and the
+/// target light's own triangles never block it. Counts a triangle test.
+#[inline]
+pub fn blocks(scene: &Scene, ray: &ShadowRay, t: TriId, ctx: &mut QueryCtx) -> bool {
+    if t == ray.origin_tri || scene.tri_light[t.idx()] == Some(ray.light) {
+        return false;
+    }
+    ctx.stats.triangle_tests += 1;
+    ray.test.hit(&scene.triangles[t.idx()]).is_some()
+}
