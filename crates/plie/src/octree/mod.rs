@@ -1,5 +1,6 @@
-//! The octree of SPEC §3 (work in progress: being written).
+//! The octree of SPEC §3 (placeholder on main until the octree branch lands).
 
+use glam::Vec3;
 use serde::{Deserialize, Serialize};
 
 /// Index of an octree leaf.
@@ -8,3 +9,10 @@ pub struct LeafId(pub u32);
 
 /// The octree.
 pub struct Octree;
+
+impl Octree {
+    /// Leaf containing `p`.
+    pub fn locate(&self, _p: Vec3) -> Option<LeafId> {
+        None
+    }
+}
