@@ -5,6 +5,7 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use anyhow::{Context, Result};
+use plie::lie::PlieParams;
 use plie::octree::{Octree, OctreeParams};
 use plie::render::{render, RenderSettings};
 use plie::visibility::bvh::Bvh;
@@ -88,8 +89,14 @@ pub fn run(a: &Args) -> Result<()> {
     let octree = Octree::build(&scene, params);
     let octree_seconds = t.elapsed().as_secs_f64();
 
-    let vis = visibility::for_mode(a.visibility, &scene, &bvh, &octree);
     let bar = Bar::new(a.quiet || a.json);
+    let t = Instant::now();
+    let plie = a.visibility.needs_plie().then(|| {
+        let params = PlieParams { max_triangles: a.max_triangles, max_depth: a.max_depth };
+        plie::construct::build(&scene, &octree, params, &bar).0
+    });
+    let plie_seconds = t.elapsed().as_secs_f64();
+    let vis = visibility::for_mode(a.visibility, &scene, &bvh, &octree, plie.as_ref())?;
     let out = render(&scene, &camera, &settings, &bvh, Some(&octree), vis.as_ref(), &bar)?;
     plie::io::save_image(&a.output, a.width, a.height, &out.pixels)
         .with_context(|| format!("cannot write {}", a.output.display()))?;
@@ -114,6 +121,7 @@ pub fn run(a: &Args) -> Result<()> {
             "octree_build_seconds": octree_seconds,
             "octree_leaves": octree.leaf_count(),
             "octree_depth": octree.depth(),
+            "build_seconds": plie.as_ref().map(|_| plie_seconds),
             "hit_buffer_seconds": out.hit_buffer_seconds,
             "shading_seconds": out.shading_seconds,
             "shadow_rays": s.shadow_rays,
@@ -133,6 +141,9 @@ pub fn run(a: &Args) -> Result<()> {
         eprintln!("load             {load_seconds:.3} s");
         eprintln!("bvh build        {bvh_seconds:.3} s");
         eprintln!("octree build     {octree_seconds:.3} s ({} leaves, depth {})", octree.leaf_count(), octree.depth());
+        if plie.is_some() {
+            eprintln!("p-lie build      {plie_seconds:.3} s");
+        }
         eprintln!("hit buffer       {:.3} s", out.hit_buffer_seconds);
         eprintln!("shading          {:.3} s", out.shading_seconds);
         eprintln!("shadow rays      {} ({:.1}% occluded, {:.2} M/s)", s.shadow_rays, 100.0 * s.occluded as f64 / s.shadow_rays.max(1) as f64, rays_per_second / 1e6);

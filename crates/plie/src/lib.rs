@@ -12,6 +12,8 @@ pub mod scene;
 
 pub use error::{Error, Result};
 pub use scene::{Camera, Light, LightId, Material, MaterialId, Scene, SceneBuilder, TriId};
+pub mod construct;
+pub mod lie;
 pub mod octree;
 pub mod visibility;
 pub mod render;
