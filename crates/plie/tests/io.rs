@@ -11,6 +11,8 @@ mod gltf;
 mod images;
 #[path = "io/lights.rs"]
 mod lights;
+#[path = "io/robustness.rs"]
+mod robustness;
 
 use std::path::{Path, PathBuf};
 
@@ -254,7 +256,7 @@ fn undefined_material() {
     let msg = parse_error(load_from(files, "t.obj"), "t.obj", Some(2));
     assert!(msg.contains("'glass'") && msg.contains("l.mtl"), "{msg}");
     let msg = parse_error(load_from(&[("n.obj", b"usemtl lamp\n")], "n.obj"), "n.obj", Some(1));
-    assert!(msg.contains("no mtllib"), "{msg}");
+    assert!(msg.contains("no mtllib comes before it"), "{msg}");
 }
 
 #[test]

@@ -33,6 +33,7 @@ pub fn load_gltf(path: &Path) -> Result<Scene> {
     if bytes.is_empty() {
         return Err(bad("the file is empty".into()));
     }
+    check_glb_header(&bytes).map_err(bad)?;
     let gltf = ::gltf::Gltf::from_slice(&bytes).map_err(|e| gltf_error(path, e))?;
     let buffers = load_buffers(path, &gltf.document, gltf.blob.clone())?;
     let doc = &gltf.document;
@@ -90,6 +91,20 @@ fn gltf_error(path: &Path, e: ::gltf::Error) -> Error {
     }
 }
 
+/// The `gltf` crate subtracts the header size from the GLB's length field unchecked (an overflow
+/// panic in debug builds): check the header first.
+fn check_glb_header(bytes: &[u8]) -> Result<(), String> {
+    if !bytes.starts_with(b"glTF") {
+        return Ok(());
+    }
+    let Some(length) = bytes.get(8..12) else { return Err("truncated GLB header".into()) };
+    let length = u32::from_le_bytes([length[0], length[1], length[2], length[3]]);
+    if length < 20 || length as usize > bytes.len() {
+        return Err(format!("GLB header says {length} bytes, but the file has {}", bytes.len()));
+    }
+    Ok(())
+}
+
 /// Reads every buffer (GLB chunk, data URI or external file), naming the buffer that fails.
 fn load_buffers(path: &Path, doc: &Document, mut blob: Option<Vec<u8>>) -> Result<Vec<::gltf::buffer::Data>> {
     let base = path.parent().unwrap_or(Path::new("."));
@@ -102,6 +117,12 @@ fn load_buffers(path: &Path, doc: &Document, mut blob: Option<Vec<u8>>) -> Resul
             ::gltf::buffer::Source::Uri(uri) => format!("buffer {} ('{}')", buffer.index(), base.join(uri).display()),
             ::gltf::buffer::Source::Bin => format!("buffer {} (GLB binary chunk)", buffer.index()),
         };
+        // The crate unwraps the percent-decoding of relative URIs: check it first.
+        if let ::gltf::buffer::Source::Uri(uri) = buffer.source() {
+            if !uri.contains(':') && urlencoding::decode(uri).is_err() {
+                return Err(parse_error(path, None, format!("{what}: the URI is not UTF-8 after percent-decoding")));
+            }
+        }
         let data = ::gltf::buffer::Data::from_source_and_blob(buffer.source(), Some(base), &mut blob)
             .map_err(|e| parse_error(path, None, format!("cannot load {what}: {e}")))?;
         if data.len() < buffer.length() {

@@ -146,9 +146,9 @@ pub fn decode_pfm(bytes: &[u8]) -> Result<(u32, u32, Vec<Vec3>), String> {
         return Err(format!("bad PFM scale '{}'", tokens[3]));
     }
     let data = &bytes[pos..];
-    let expected = w as u64 * h as u64 * channels * 4;
-    if data.len() as u64 != expected {
-        let what = if (data.len() as u64) < expected { "truncated" } else { "trailing bytes after the" };
+    let expected = w as u128 * h as u128 * channels * 4;
+    if data.len() as u128 != expected {
+        let what = if (data.len() as u128) < expected { "truncated" } else { "trailing bytes after the" };
         return Err(format!("{what} PFM data: {w} x {h} needs {expected} bytes, found {}", data.len()));
     }
     let read = |c: &[u8]| {

@@ -143,7 +143,7 @@ impl<'a> ObjRules<'a> {
         let libs = self.libs.borrow();
         if !libs.names.contains(name) {
             return Err(if libs.libs.is_empty() {
-                format!("usemtl '{name}', but the file has no mtllib: the material is not defined")
+                format!("usemtl '{name}', but no mtllib comes before it: the material is not defined")
             } else {
                 format!("usemtl '{name}': no material of that name in {}", libs.libs.join(", "))
             });

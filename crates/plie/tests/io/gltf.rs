@@ -59,6 +59,16 @@ fn embedded() -> Value {
     document(json!({"uri": data_uri(), "byteLength": 120}))
 }
 
+/// The embedded-buffer document, for other test modules.
+pub fn embedded_document() -> Value {
+    embedded()
+}
+
+/// The same scene as a `.glb` file, for other test modules.
+pub fn glb_file() -> Vec<u8> {
+    glb(&document(json!({"byteLength": 120})), &buffer())
+}
+
 fn load_json(doc: &Value) -> plie::Result<plie::Scene> {
     load_from(&[("s.gltf", doc.to_string().as_bytes())], "s.gltf")
 }
@@ -131,6 +141,19 @@ fn binary_glb() {
 }
 
 #[test]
+fn inputs_the_gltf_crate_would_panic_on() {
+    // A GLB length field smaller than the header underflows inside the crate.
+    let mut bytes = glb_file();
+    bytes[8..12].copy_from_slice(&5u32.to_le_bytes());
+    let msg = parse_error(load_from(&[("s.glb", &bytes)], "s.glb"), "s.glb", None);
+    assert!(msg.contains("GLB header says 5 bytes"), "{msg}");
+    // A relative URI that is not UTF-8 after percent-decoding makes the crate unwrap an error.
+    let doc = document(json!({"uri": "%FF.bin", "byteLength": 120}));
+    let msg = parse_error(load_json(&doc), "s.gltf", None);
+    assert!(msg.contains("percent-decoding"), "{msg}");
+}
+
+#[test]
 fn non_indexed_fan_and_mirrored_node() {
     let mut doc = embedded();
     doc["meshes"][1]["primitives"][0] = json!({"attributes": {"POSITION": 1}, "material": 1, "mode": 6});
@@ -165,6 +188,11 @@ fn malformed_json() {
     doc["nodes"][0]["mesh"] = json!(7);
     let msg = parse_error(load_json(&doc), "s.gltf", None);
     assert!(msg.contains("invalid glTF"), "{msg}");
+    // Geometry in an extension plie cannot decode.
+    let mut doc = embedded();
+    doc["extensionsRequired"] = json!(["KHR_draco_mesh_compression"]);
+    let msg = parse_error(load_json(&doc), "s.gltf", None);
+    assert!(msg.contains("extensionsRequired") && msg.contains("KHR_draco_mesh_compression"), "{msg}");
 }
 
 #[test]
