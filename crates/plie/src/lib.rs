@@ -8,6 +8,7 @@
 
 pub mod error;
 pub mod geometry;
+pub mod io;
 pub mod scene;
 
 pub use error::{Error, Result};
