@@ -133,12 +133,13 @@ pub(super) fn rest_after_keyword<'a>(line: &'a str, keyword: &str) -> &'a str {
     line.trim_start().get(keyword.len()..).unwrap_or("").trim()
 }
 
-/// Parses a finite `f32`, naming `what` in the error.
-pub(super) fn parse_finite(token: &str, what: &str) -> Result<f32, String> {
+/// Parses a finite `f32`; `what` names the value's owner in the error (a closure, so the name is only
+/// formatted on error).
+pub(super) fn parse_finite<S: std::fmt::Display>(token: &str, what: impl Fn() -> S) -> Result<f32, String> {
     match token.parse::<f32>() {
         Ok(x) if x.is_finite() => Ok(x),
-        Ok(_) => Err(format!("{what} has a non-finite value '{token}'")),
-        Err(_) => Err(format!("malformed number '{token}' in {what}")),
+        Ok(_) => Err(format!("{} has a non-finite value '{token}'", what())),
+        Err(_) => Err(format!("malformed number '{token}' in {}", what())),
     }
 }
 
