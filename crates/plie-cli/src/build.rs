@@ -82,10 +82,25 @@ pub fn run(a: &Args) -> Result<()> {
         });
         println!("{v}");
     } else if !a.quiet {
-        println!("scene           {} ({} triangles, {} lights)", scene.name, scene.triangle_count(), scene.lights.len());
+        println!(
+            "scene           {} ({} triangles, {} lights)",
+            scene.name,
+            scene.triangle_count(),
+            scene.lights.len()
+        );
         println!("octree          {} leaves, depth {} ({:.3} s)", octree.leaf_count(), octree.depth(), octree_seconds);
-        println!("data objects    {} of {} (leaf, face, light); {} without: the face cannot see the light", stats.records, stats.faces_considered, stats.no_record_face_cannot_see_light);
-        println!("blockers        {} in all, {:.1} per record (max {}), {} candidates clipped ({:.3} s)", stats.blockers_total, stats.blockers_mean, stats.blockers_max, stats.candidates_clipped, stats.blockers_seconds);
+        println!(
+            "data objects    {} of {} (leaf, face, light); {} without: the face cannot see the light",
+            stats.records, stats.faces_considered, stats.no_record_face_cannot_see_light
+        );
+        println!(
+            "blockers        {} in all, {:.1} per record (max {}), {} candidates clipped ({:.3} s)",
+            stats.blockers_total,
+            stats.blockers_mean,
+            stats.blockers_max,
+            stats.candidates_clipped,
+            stats.blockers_seconds
+        );
         println!("build           {build_seconds:.3} s");
         println!("memory          {memory} bytes (octree {} + P-LIE {})", octree.memory_bytes(), plie.memory_bytes());
         println!("file            {} ({file_bytes} bytes, written in {write_seconds:.3} s)", a.output.display());

@@ -144,9 +144,17 @@ pub fn run(a: &Args) -> Result<()> {
         println!("{v}");
     }
     if a.stats {
-        eprintln!("scene            {} ({} triangles, {} lights)", scene.name, scene.triangle_count(), scene.lights.len());
+        eprintln!(
+            "scene            {} ({} triangles, {} lights)",
+            scene.name,
+            scene.triangle_count(),
+            scene.lights.len()
+        );
         eprintln!("visibility       {}", a.visibility);
-        eprintln!("image            {}x{}, {}x{} eye rays/pixel, {} shadow rays/light", a.width, a.height, a.eye_rays, a.eye_rays, a.shadow_rays);
+        eprintln!(
+            "image            {}x{}, {}x{} eye rays/pixel, {} shadow rays/light",
+            a.width, a.height, a.eye_rays, a.eye_rays, a.shadow_rays
+        );
         eprintln!("threads          {}", rayon::current_num_threads());
         eprintln!("load             {load_seconds:.3} s");
         eprintln!("bvh build        {bvh_seconds:.3} s");
@@ -159,7 +167,12 @@ pub fn run(a: &Args) -> Result<()> {
         }
         eprintln!("hit buffer       {:.3} s", out.hit_buffer_seconds);
         eprintln!("shading          {:.3} s", out.shading_seconds);
-        eprintln!("shadow rays      {} ({:.1}% occluded, {:.2} M/s)", s.shadow_rays, 100.0 * s.occluded as f64 / s.shadow_rays.max(1) as f64, rays_per_second / 1e6);
+        eprintln!(
+            "shadow rays      {} ({:.1}% occluded, {:.2} M/s)",
+            s.shadow_rays,
+            100.0 * s.occluded as f64 / s.shadow_rays.max(1) as f64,
+            rays_per_second / 1e6
+        );
         eprintln!("triangle tests   {} ({per_ray:.2} per shadow ray)", s.triangle_tests);
     }
     if !a.quiet && !a.json && !a.stats {

@@ -52,13 +52,37 @@ fn render_writes_png_and_json() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("c.png");
     let o = plie(&[
-        "render", "--scene", "cornell-cube-2", "-o", out.to_str().unwrap(), "--width", "24", "--height", "20",
-        "--eye-rays", "1", "--shadow-rays", "2", "--json", "--visibility", "bvh",
+        "render",
+        "--scene",
+        "cornell-cube-2",
+        "-o",
+        out.to_str().unwrap(),
+        "--width",
+        "24",
+        "--height",
+        "20",
+        "--eye-rays",
+        "1",
+        "--shadow-rays",
+        "2",
+        "--json",
+        "--visibility",
+        "bvh",
     ]);
     assert!(o.status.success(), "{}", stderr(&o));
     let v: serde_json::Value = serde_json::from_slice(&o.stdout).expect("one JSON object on stdout");
-    for key in ["scene", "triangles", "lights", "visibility", "width", "height", "hit_buffer_seconds",
-        "shading_seconds", "shadow_rays", "triangle_tests"] {
+    for key in [
+        "scene",
+        "triangles",
+        "lights",
+        "visibility",
+        "width",
+        "height",
+        "hit_buffer_seconds",
+        "shading_seconds",
+        "shadow_rays",
+        "triangle_tests",
+    ] {
         assert!(v.get(key).is_some(), "missing {key} in {v}");
     }
     assert_eq!(v["triangles"], 32);
@@ -75,8 +99,24 @@ fn render_pfm_is_identical_for_every_mode() {
     for mode in ["brute", "octree", "bvh"] {
         let out = dir.path().join(format!("{mode}.pfm"));
         let o = plie(&[
-            "render", "--scene", "cornell-cube-1", "-o", out.to_str().unwrap(), "--width", "16", "--height", "16",
-            "--eye-rays", "1", "--shadow-rays", "3", "--visibility", mode, "--quiet", "--seed", "3",
+            "render",
+            "--scene",
+            "cornell-cube-1",
+            "-o",
+            out.to_str().unwrap(),
+            "--width",
+            "16",
+            "--height",
+            "16",
+            "--eye-rays",
+            "1",
+            "--shadow-rays",
+            "3",
+            "--visibility",
+            mode,
+            "--quiet",
+            "--seed",
+            "3",
         ]);
         assert!(o.status.success(), "{}", stderr(&o));
         images.push(std::fs::read(&out).unwrap());
@@ -122,9 +162,15 @@ fn unknown_scene_and_bad_output_give_one_line_errors() {
     fails_with(&["render", "--scene", "missing-file.obj", "-o", "/tmp/x.png"], "missing-file.obj");
     let dir = tempfile::tempdir().unwrap();
     let bad = dir.path().join("no/such/dir/out.png");
-    fails_with(&["render", "--scene", "cornell-cube-1", "-o", bad.to_str().unwrap(), "--width", "8", "--height", "8"], "out.png");
+    fails_with(
+        &["render", "--scene", "cornell-cube-1", "-o", bad.to_str().unwrap(), "--width", "8", "--height", "8"],
+        "out.png",
+    );
     let bad = dir.path().join("out.bmp");
-    fails_with(&["render", "--scene", "cornell-cube-1", "-o", bad.to_str().unwrap(), "--width", "8", "--height", "8"], "out.bmp");
+    fails_with(
+        &["render", "--scene", "cornell-cube-1", "-o", bad.to_str().unwrap(), "--width", "8", "--height", "8"],
+        "out.bmp",
+    );
     fails_with(&["render", "--scene", "cornell-cube-1", "-o", "/tmp/x.png", "--width", "0"], "size");
     fails_with(&["render", "--scene", "cornell-cube-1", "-o", "/tmp/x.png", "--fov", "200"], "field of view");
 }

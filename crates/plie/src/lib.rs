@@ -16,5 +16,5 @@ pub use scene::{Camera, Light, LightId, Material, MaterialId, Scene, SceneBuilde
 pub mod construct;
 pub mod lie;
 pub mod octree;
-pub mod visibility;
 pub mod render;
+pub mod visibility;

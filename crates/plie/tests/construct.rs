@@ -128,7 +128,13 @@ fn thesis_dot_product_rule_drops_a_needed_record() {
     // A light tilted away from an Up face (n_face . n_light > 0) that still shines down onto it.
     let mut b = SceneBuilder::new("tilted");
     let w = b.diffuse("w", Vec3::splat(0.7));
-    b.quad(Vec3::new(-5.0, 0.0, -5.0), Vec3::new(-5.0, 0.0, 5.0), Vec3::new(5.0, 0.0, 5.0), Vec3::new(5.0, 0.0, -5.0), w);
+    b.quad(
+        Vec3::new(-5.0, 0.0, -5.0),
+        Vec3::new(-5.0, 0.0, 5.0),
+        Vec3::new(5.0, 0.0, 5.0),
+        Vec3::new(5.0, 0.0, -5.0),
+        w,
+    );
     // Emits toward -x and slightly up: normal (-1, 0.2, 0) normalised.
     let c = Vec3::new(4.0, 3.0, 0.0);
     let up = Vec3::new(0.2, 1.0, 0.0).normalize();

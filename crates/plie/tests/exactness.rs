@@ -109,13 +109,20 @@ fn compare(scene: &Scene, built: &Built, what: &str, modes: &[Mode], rays: &[Sha
     for &mode in modes.iter().filter(|&&m| m != Mode::Brute) {
         let got = answers(scene, built, mode, sample);
         if let Some(i) = (0..got.len()).find(|&i| got[i] != reference[i]) {
-            panic!("{}: {mode} says {} for {what} {i} {:?}, brute force says {}", scene.name, got[i], sample[i], reference[i]);
+            panic!(
+                "{}: {mode} says {} for {what} {i} {:?}, brute force says {}",
+                scene.name, got[i], sample[i], reference[i]
+            );
         }
     }
     if big {
         let reference = answers(scene, built, Mode::Bvh, rays);
         for &mode in modes.iter().filter(|&&m| m != Mode::Brute && m != Mode::Bvh) {
-            assert!(answers(scene, built, mode, rays) == reference, "{}: {mode} disagrees with bvh on {what}", scene.name);
+            assert!(
+                answers(scene, built, mode, rays) == reference,
+                "{}: {mode} disagrees with bvh on {what}",
+                scene.name
+            );
         }
     }
 }

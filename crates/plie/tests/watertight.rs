@@ -64,7 +64,8 @@ fn rays_through_shared_vertices_and_edges_never_slip_through() {
             assert!(vis.occluded(&ray, &mut ctx), "{mode}: ray through {p} slipped through");
             // And along an axis-parallel direction through the same point.
             let from = *p + Vec3::new(0.0, 5.0, 0.0);
-            let ray = ShadowRay::new(from, center + (*p - center) * 0.5 - Vec3::Y * 5.0, LightId(0), TriId(u32::MAX), None);
+            let ray =
+                ShadowRay::new(from, center + (*p - center) * 0.5 - Vec3::Y * 5.0, LightId(0), TriId(u32::MAX), None);
             let brute = built.vis(&scene, Mode::Brute).occluded(&ray, &mut ctx);
             assert_eq!(vis.occluded(&ray, &mut ctx), brute, "{mode}: disagrees with brute force");
         }

@@ -74,7 +74,11 @@ pub fn build(scene: &Scene, octree: &Octree, params: PlieParams, progress: &dyn 
         .collect();
     progress.finish();
 
-    let mut stats = BuildStats { leaves: octree.leaf_count(), faces_considered: octree.leaf_count() * 6 * lights, ..Default::default() };
+    let mut stats = BuildStats {
+        leaves: octree.leaf_count(),
+        faces_considered: octree.leaf_count() * 6 * lights,
+        ..Default::default()
+    };
     let mut plie = Plie {
         params,
         leaves: octree.leaf_count() as u32,

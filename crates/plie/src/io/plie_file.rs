@@ -164,7 +164,13 @@ pub fn load_plie(path: &Path, scene: &Scene, expect: Option<PlieParams>) -> Resu
 /// Every index in range, every record where the index says it is.
 fn check_structure(p: &Plie, scene: &Scene, octree: &Octree) -> std::result::Result<(), String> {
     if p.leaves as usize != octree.leaf_count() || p.lights as usize != scene.lights.len() {
-        return Err(format!("{} leaves and {} lights, expected {} and {}", p.leaves, p.lights, octree.leaf_count(), scene.lights.len()));
+        return Err(format!(
+            "{} leaves and {} lights, expected {} and {}",
+            p.leaves,
+            p.lights,
+            octree.leaf_count(),
+            scene.lights.len()
+        ));
     }
     if p.record_index.len() != p.leaves as usize * 6 * p.lights as usize {
         return Err("record table has the wrong size".into());

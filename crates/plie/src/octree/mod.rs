@@ -17,8 +17,8 @@
 //! Stages: [`build`] (construction), [`locate`] (point location), [`traverse`] (segments and boxes),
 //! [`validate`] (invariant report).
 
-pub mod dir;
 pub mod build;
+pub mod dir;
 pub mod locate;
 pub mod traverse;
 pub mod validate;

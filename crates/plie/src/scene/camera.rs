@@ -61,13 +61,15 @@ impl Camera {
         Ok(())
     }
 
-    /// A camera looking along +z at the box from in front, far enough that the box's bounding sphere
-    /// fits the vertical field of view: the default for scene files that carry no camera.
-    pub fn framing(bounds: &Aabb, fov_deg: f32) -> Camera {
+    /// A camera at the box's center plus `from` (a horizontal direction), looking back at the center
+    /// with y up, far enough that the box's bounding sphere fits the vertical field of view: the
+    /// default for scene files that carry no camera.
+    pub fn framing(bounds: &Aabb, fov_deg: f32, from: Vec3) -> Camera {
         let center = bounds.center();
         let radius = (bounds.diagonal() * 0.5).max(1e-6);
         let dist = radius / (fov_deg.to_radians() * 0.5).sin();
-        Camera { eye: center - Vec3::Z * dist, target: center, up: Vec3::Y, fov_deg }
+        let from = Vec3::new(from.x, 0.0, from.z).try_normalize().unwrap_or(-Vec3::Z);
+        Camera { eye: center + from * dist, target: center, up: Vec3::Y, fov_deg }
     }
 
     /// The frame for an image of `width` x `height` pixels.

@@ -50,9 +50,23 @@ impl Scene {
         &self.materials[self.tri_material[t.idx()].idx()]
     }
 
-    /// The scene's camera, or a default one framing the scene.
+    /// The scene's camera, or a default one framing the scene. The default looks from the side most
+    /// surfaces face (area-weighted front normals, horizontal part), so an open room is seen through
+    /// its open side; where no side dominates, from -z.
     pub fn camera_or_default(&self) -> Camera {
-        self.camera.unwrap_or_else(|| Camera::framing(&self.bounds, 40.0))
+        self.camera.unwrap_or_else(|| {
+            let (mut sum, mut area) = (Vec3::ZERO, 0.0);
+            for (t, l) in self.triangles.iter().zip(&self.tri_light) {
+                if l.is_none() {
+                    let c = t.cross();
+                    sum += c;
+                    area += c.length();
+                }
+            }
+            let horizontal = Vec3::new(sum.x, 0.0, sum.z);
+            let from = if horizontal.length() > 0.05 * area { horizontal } else { -Vec3::Z };
+            Camera::framing(&self.bounds, 40.0, from)
+        })
     }
 
     /// A length scale for tolerances: the largest extent of the scene's bounding box.

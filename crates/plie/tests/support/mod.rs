@@ -76,7 +76,11 @@ impl Built {
         Built { bvh, octree, plie }
     }
 
-    pub fn vis<'a>(&'a self, scene: &'a Scene, mode: plie::visibility::Mode) -> Box<dyn plie::visibility::Visibility + 'a> {
+    pub fn vis<'a>(
+        &'a self,
+        scene: &'a Scene,
+        mode: plie::visibility::Mode,
+    ) -> Box<dyn plie::visibility::Visibility + 'a> {
         plie::visibility::for_mode(mode, scene, &self.bvh, &self.octree, Some(&self.plie)).unwrap()
     }
 }
