@@ -6,10 +6,12 @@
 
 pub mod aabb;
 pub mod ray_triangle;
+pub mod segment;
 pub mod tri_box;
 pub mod triangle;
 
 pub use aabb::Aabb;
 pub use ray_triangle::RayTest;
+pub use segment::Segment;
 pub use tri_box::triangle_overlaps_box;
 pub use triangle::Triangle;

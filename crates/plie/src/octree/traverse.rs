@@ -6,76 +6,19 @@
 //! touches, including segments lying in a cell's face plane, running along an edge, starting on a
 //! corner or having zero direction components; leaves it passes within `eps` of are visited too.
 //!
-//! The slab test is written here rather than taken from [`Aabb::clip_ray`]: an axis whose direction
-//! component is zero (or so small that its inverse overflows) is tested as an interval of coordinates
-//! instead, since `0 * inf = NaN` would otherwise decide the answer. Rounding in the slab test is a few
-//! `f32` ulps of the coordinates, far below `eps` (see [`super::build::tolerance`]).
+//! The slab test is [`Segment::clip`], which treats axes with a non-finite inverse direction as
+//! coordinate intervals. Rounding in the slab test is a few `f32` ulps of the coordinates, far below
+//! `eps` (see [`super::build::tolerance`]).
 //!
 //! Both walks use a fixed-size stack on the call stack; nothing is allocated.
 
 use glam::Vec3;
 
 use super::{LeafId, NodeKind, Octree, MAX_DEPTH_LIMIT};
-use crate::geometry::Aabb;
+use crate::geometry::{Aabb, Segment};
 
 /// Stack capacity: each inner level leaves at most 7 siblings behind, plus the 8 of the deepest level.
 const STACK: usize = 8 * (MAX_DEPTH_LIMIT as usize + 1);
-
-/// A segment `origin + t * dir`, `t` in `[t_min, t_max]`, prepared for slab tests.
-#[derive(Clone, Copy, Debug)]
-struct Segment {
-    origin: Vec3,
-    inv_dir: Vec3,
-    t_min: f32,
-    t_max: f32,
-    /// Bit k set: axis k is treated as parallel (the inverse direction is not finite).
-    parallel: u32,
-    /// For parallel axes: the range of coordinates the segment covers.
-    span_lo: Vec3,
-    span_hi: Vec3,
-}
-
-impl Segment {
-    fn new(origin: Vec3, dir: Vec3, t_min: f32, t_max: f32) -> Segment {
-        let inv_dir = dir.recip();
-        let mut parallel = 0;
-        let mut span_lo = origin;
-        let mut span_hi = origin;
-        for k in 0..3 {
-            if !inv_dir[k].is_finite() {
-                parallel |= 1 << k;
-                if dir[k] != 0.0 {
-                    // Tiny but non-zero: the coordinate still moves a little along the segment.
-                    let a = origin[k] + dir[k] * t_min;
-                    let b = origin[k] + dir[k] * t_max;
-                    span_lo[k] = a.min(b).min(origin[k]);
-                    span_hi[k] = a.max(b).max(origin[k]);
-                }
-            }
-        }
-        Segment { origin, inv_dir, t_min, t_max, parallel, span_lo, span_hi }
-    }
-
-    /// The parameter interval in which the segment lies in the closed box `b`, if any.
-    #[inline]
-    fn clip(&self, b: &Aabb) -> Option<(f32, f32)> {
-        let mut t0 = self.t_min;
-        let mut t1 = self.t_max;
-        for k in 0..3 {
-            if self.parallel & (1 << k) != 0 {
-                if self.span_hi[k] < b.min[k] || self.span_lo[k] > b.max[k] {
-                    return None;
-                }
-            } else {
-                let a = (b.min[k] - self.origin[k]) * self.inv_dir[k];
-                let c = (b.max[k] - self.origin[k]) * self.inv_dir[k];
-                t0 = t0.max(a.min(c));
-                t1 = t1.min(a.max(c));
-            }
-        }
-        (t0 <= t1).then_some((t0, t1))
-    }
-}
 
 impl Octree {
     /// Visits, front to back, every leaf whose box grown by [`Octree::eps`] the segment

@@ -4,21 +4,35 @@
 //! of `c` itself (the part inside `c`). A segment that never leaves `c` only needs `c`'s triangles.
 
 use super::{blocks, OctreeVisibility, QueryCtx, ShadowRay, Visibility};
+use crate::geometry::{Aabb, Segment};
 use crate::lie::Plie;
 use crate::octree::{Dir, LeafId, Octree};
-use crate::scene::Scene;
+use crate::scene::{Scene, TriId};
 
 /// Mode (b): the P-LIE's blocker lists.
+///
+/// Before a candidate gets the watertight test, its bounding box (grown by the construction tolerance)
+/// is tested against the segment: a conservative cull (SPEC §8 point 4) that never changes an answer.
 pub struct LieVisibility<'a> {
     scene: &'a Scene,
     octree: &'a Octree,
     plie: &'a Plie,
+    /// Grown bounding box of every triangle.
+    tri_boxes: Vec<Aabb>,
 }
 
 impl<'a> LieVisibility<'a> {
     /// Mode (b) over a P-LIE built for `scene` and `octree`.
     pub fn new(scene: &'a Scene, octree: &'a Octree, plie: &'a Plie) -> LieVisibility<'a> {
-        LieVisibility { scene, octree, plie }
+        let pad = scene.scale() * crate::construct::TOLERANCE_REL;
+        let tri_boxes = scene.triangles.iter().map(|t| t.aabb().expanded(pad)).collect();
+        LieVisibility { scene, octree, plie, tri_boxes }
+    }
+
+    /// The box cull, then the shared predicate.
+    #[inline]
+    fn test(&self, seg: &Segment, ray: &ShadowRay, t: TriId, ctx: &mut QueryCtx) -> bool {
+        seg.clip(&self.tri_boxes[t.idx()]).is_some() && blocks(self.scene, ray, t, ctx)
     }
 }
 
@@ -50,16 +64,17 @@ impl Visibility for LieVisibility<'_> {
             // Outside the octree: no environment to consult.
             return OctreeVisibility::new(self.scene, self.octree).occluded(ray, ctx);
         };
+        let seg = Segment::new(ray.test.origin, ray.test.dir, ray.test.t_min, ray.test.t_max);
         if let Some(face) = exit_face(self.octree, leaf, ray) {
             let Some(record) = self.plie.record(leaf, face, ray.light) else {
                 return true;
             };
             for &t in self.plie.blockers_of(record) {
-                if blocks(self.scene, ray, t, ctx) {
+                if self.test(&seg, ray, t, ctx) {
                     return true;
                 }
             }
         }
-        self.octree.leaf_triangles(leaf).iter().any(|&t| blocks(self.scene, ray, t, ctx))
+        self.octree.leaf_triangles(leaf).iter().any(|&t| self.test(&seg, ray, t, ctx))
     }
 }
