@@ -1,1 +1,50 @@
-fn main() {}
+//! `plie`: the command-line tool. Parses arguments, calls the library, prints results and errors.
+//! One file per subcommand; errors get context here and end the process with a one-line message and
+//! exit code 1 (clap's usage errors exit with 2).
+
+mod progress;
+mod render;
+mod scene_arg;
+mod scenes;
+
+use clap::{Parser, Subcommand};
+
+/// Exact soft shadows from area lights with Preprocessed Local Illumination Environments.
+#[derive(Parser)]
+#[command(name = "plie", version, about, propagate_version = true)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// List the built-in scenes: name, triangles, lights.
+    Scenes(scenes::Args),
+    /// Render a scene with direct lighting from its area lights.
+    Render(Box<render::Args>),
+}
+
+fn main() {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Scenes(a) => scenes::run(&a),
+        Command::Render(a) => render::run(&a),
+    };
+    if let Err(e) = result {
+        eprintln!("error: {}", one_line(&e));
+        std::process::exit(1);
+    }
+}
+
+/// The error and its causes on one line.
+fn one_line(e: &anyhow::Error) -> String {
+    let mut parts: Vec<String> = Vec::new();
+    for cause in e.chain() {
+        let s = cause.to_string().replace('\n', " ");
+        if !parts.iter().any(|p| p.contains(&s)) {
+            parts.push(s);
+        }
+    }
+    parts.join(": ")
+}

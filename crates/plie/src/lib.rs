@@ -14,3 +14,4 @@ pub use error::{Error, Result};
 pub use scene::{Camera, Light, LightId, Material, MaterialId, Scene, SceneBuilder, TriId};
 pub mod octree;
 pub mod visibility;
+pub mod render;

@@ -47,7 +47,7 @@ impl Triangle {
     pub fn is_degenerate(&self) -> bool {
         let e = (self.v[1] - self.v[0]).length().max((self.v[2] - self.v[0]).length());
         let c = self.cross().length();
-        !(c > 1e-12 * e * e) || !c.is_finite()
+        c.is_nan() || c <= 1e-12 * e * e || !c.is_finite()
     }
 
     /// The point with barycentric coordinates `(1 - u - v, u, v)`.

@@ -1,10 +1,240 @@
-//! The octree of SPEC §3 (work in progress: being written).
+//! The octree of SPEC §3 (thesis §3.1.2, §5.1): a cube around the scene, split into 8 children at the
+//! root and then wherever a cell holds more than `max_triangles` triangles, down to `max_depth`.
+//!
+//! Triangles are assigned with the exact separating-axis test against the cell box grown by
+//! [`Octree::eps`] (SPEC §3 **Correction**: the thesis' vertex/edge test misses large triangles), so a
+//! triangle may sit in many leaves and every gathering query must de-duplicate.
+//!
+//! Layout (flat arrays, `u32` indices, nothing allocated per node):
+//! - `nodes[0]` is the root; an inner node stores the index of its first child, and its 8 children are
+//!   consecutive. Child `i` of a cell is the octant with bit 0 = upper half in x, bit 1 = upper half in
+//!   y, bit 2 = upper half in z (see [`child_box`]). A leaf node stores its [`LeafId`].
+//! - `node_bounds[n]` is the box of node `n`; every box is computed from its parent's by [`child_box`],
+//!   so neighbouring cells share their faces bit for bit.
+//! - `leaves[l]` holds the leaf's node, depth and a range into `leaf_tris`, the concatenation of all
+//!   leaf triangle lists. Each list is sorted by ascending [`TriId`]. Leaves are numbered breadth-first.
+//!
+//! Stages: [`build`] (construction), [`locate`] (point location), [`traverse`] (segments and boxes),
+//! [`validate`] (invariant report).
+
+pub mod dir;
+pub mod build;
+pub mod locate;
+pub mod traverse;
+pub mod validate;
+
+pub use dir::Dir;
 
 use serde::{Deserialize, Serialize};
+
+use crate::error::{Error, Result};
+use crate::geometry::Aabb;
+use crate::scene::TriId;
+
+pub use validate::{OctreeReport, Violation};
 
 /// Index of an octree leaf.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, Deserialize)]
 pub struct LeafId(pub u32);
 
-/// The octree.
-pub struct Octree;
+impl LeafId {
+    /// The index as `usize`.
+    #[inline]
+    pub fn idx(self) -> usize {
+        self.0 as usize
+    }
+}
+
+/// The deepest `max_depth` accepted: cells are then `2^-16` of the root, far above `f32` resolution
+/// and above the assignment tolerance.
+pub const MAX_DEPTH_LIMIT: u32 = 16;
+
+/// Octree build parameters (SPEC §3, §4.9).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub struct OctreeParams {
+    /// A cell with more triangles than this is split (unless at `max_depth`). Thesis default: 200.
+    pub max_triangles: usize,
+    /// Deepest leaf level; the root is level 0 and is always split, so leaves are at depth 1 or more.
+    /// Must be in `1..=MAX_DEPTH_LIMIT`. Default: 10 (the thesis never saw depth > 8).
+    pub max_depth: u32,
+}
+
+impl Default for OctreeParams {
+    fn default() -> OctreeParams {
+        OctreeParams::thesis()
+    }
+}
+
+impl OctreeParams {
+    /// The thesis' settings: at most 200 triangles per leaf, depth at most 10.
+    pub fn thesis() -> OctreeParams {
+        OctreeParams { max_triangles: 200, max_depth: 10 }
+    }
+
+    /// Checks the parameters: `max_triangles >= 1` and `1 <= max_depth <= MAX_DEPTH_LIMIT`.
+    pub fn validate(&self) -> Result<()> {
+        if self.max_triangles == 0 {
+            return Err(Error::InvalidParameter("octree max_triangles must be at least 1".into()));
+        }
+        if !(1..=MAX_DEPTH_LIMIT).contains(&self.max_depth) {
+            return Err(Error::InvalidParameter(format!(
+                "octree max_depth {} must be between 1 and {MAX_DEPTH_LIMIT}",
+                self.max_depth
+            )));
+        }
+        Ok(())
+    }
+}
+
+/// A node: an inner node (index of its first of 8 consecutive children) or a leaf, in one `u32`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) struct Node(u32);
+
+/// What a [`Node`] is.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum NodeKind {
+    /// Inner node; its children are `first .. first + 8`.
+    Inner(u32),
+    /// Leaf node.
+    Leaf(LeafId),
+}
+
+const LEAF_BIT: u32 = 1 << 31;
+
+impl Node {
+    /// Placeholder for a node not yet decided during the build.
+    pub(crate) const UNSET: Node = Node(u32::MAX);
+
+    pub(crate) fn inner(first_child: u32) -> Node {
+        assert!(first_child < LEAF_BIT, "octree too large");
+        Node(first_child)
+    }
+
+    pub(crate) fn leaf(l: LeafId) -> Node {
+        assert!(l.0 < LEAF_BIT, "octree too large");
+        Node(l.0 | LEAF_BIT)
+    }
+
+    #[inline]
+    pub(crate) fn kind(self) -> NodeKind {
+        if self.0 & LEAF_BIT != 0 {
+            NodeKind::Leaf(LeafId(self.0 & !LEAF_BIT))
+        } else {
+            NodeKind::Inner(self.0)
+        }
+    }
+}
+
+/// A leaf: its node, its depth and its range in the flat triangle list.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) struct Leaf {
+    pub(crate) node: u32,
+    pub(crate) depth: u32,
+    pub(crate) start: u32,
+    pub(crate) end: u32,
+}
+
+/// The octree over a scene's triangles. See the module doc for the layout.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Octree {
+    pub(crate) nodes: Vec<Node>,
+    pub(crate) node_bounds: Vec<Aabb>,
+    pub(crate) leaves: Vec<Leaf>,
+    pub(crate) leaf_tris: Vec<TriId>,
+    pub(crate) eps: f32,
+    pub(crate) params: OctreeParams,
+    pub(crate) depth: u32,
+    pub(crate) scene_triangles: usize,
+}
+
+/// Child `i` (bit 0: upper x, bit 1: upper y, bit 2: upper z) of the cell `b`. The split planes pass
+/// through `b.center()`; a lower child's upper face and the upper child's lower face are the same
+/// `f32` value, so cells tile their parent without gaps.
+#[inline]
+pub fn child_box(b: &Aabb, i: usize) -> Aabb {
+    let c = b.center();
+    let mut min = b.min;
+    let mut max = c;
+    for k in 0..3 {
+        if i & (1 << k) != 0 {
+            min[k] = c[k];
+            max[k] = b.max[k];
+        }
+    }
+    Aabb { min, max }
+}
+
+impl Octree {
+    /// Number of leaves.
+    pub fn leaf_count(&self) -> usize {
+        self.leaves.len()
+    }
+
+    /// Number of nodes, inner and leaf.
+    pub fn node_count(&self) -> usize {
+        self.nodes.len()
+    }
+
+    /// All leaf ids, in breadth-first order.
+    pub fn leaves(&self) -> impl ExactSizeIterator<Item = LeafId> + Clone {
+        (0..self.leaves.len() as u32).map(LeafId)
+    }
+
+    /// The (unexpanded, closed) box of a leaf.
+    #[inline]
+    pub fn leaf_bounds(&self, l: LeafId) -> Aabb {
+        self.node_bounds[self.leaves[l.idx()].node as usize]
+    }
+
+    /// The triangles overlapping the leaf's box grown by [`Octree::eps`], by ascending id.
+    #[inline]
+    pub fn leaf_triangles(&self, l: LeafId) -> &[TriId] {
+        let leaf = &self.leaves[l.idx()];
+        &self.leaf_tris[leaf.start as usize..leaf.end as usize]
+    }
+
+    /// Depth of a leaf (the root is depth 0, so leaves are at depth 1 or more).
+    pub fn leaf_depth(&self, l: LeafId) -> u32 {
+        self.leaves[l.idx()].depth
+    }
+
+    /// The deepest leaf's depth.
+    pub fn depth(&self) -> u32 {
+        self.depth
+    }
+
+    /// The root cube.
+    pub fn root_bounds(&self) -> Aabb {
+        self.node_bounds[0]
+    }
+
+    /// Tolerance by which cell boxes are grown for triangle assignment and traversal.
+    pub fn eps(&self) -> f32 {
+        self.eps
+    }
+
+    /// The parameters the octree was built with.
+    pub fn params(&self) -> OctreeParams {
+        self.params
+    }
+
+    /// Total number of (leaf, triangle) references.
+    pub fn triangle_refs(&self) -> usize {
+        self.leaf_tris.len()
+    }
+
+    /// Number of triangles of the scene the octree was built for.
+    pub fn scene_triangle_count(&self) -> usize {
+        self.scene_triangles
+    }
+
+    /// Heap and inline memory used, in bytes.
+    pub fn memory_bytes(&self) -> usize {
+        use std::mem::size_of;
+        size_of::<Octree>()
+            + self.nodes.capacity() * size_of::<Node>()
+            + self.node_bounds.capacity() * size_of::<Aabb>()
+            + self.leaves.capacity() * size_of::<Leaf>()
+            + self.leaf_tris.capacity() * size_of::<TriId>()
+    }
+}

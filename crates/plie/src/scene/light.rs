@@ -49,7 +49,7 @@ impl Light {
         }
         let area = 0.5 * n.length();
         let size = extent(&vertices);
-        if !(area > 1e-10 * size * size) {
+        if area.is_nan() || area <= 1e-10 * size * size {
             return Err(bad("zero area"));
         }
         let normal = n / (2.0 * area);

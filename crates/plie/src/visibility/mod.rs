@@ -21,3 +21,17 @@ pub trait Visibility: Sync {
     /// triangles) intersects the open segment. `ctx` is the calling thread's scratch space and counters.
     fn occluded(&self, ray: &ShadowRay, ctx: &mut QueryCtx) -> bool;
 }
+
+/// The visibility method for `mode`, over the structures already built.
+pub fn for_mode<'a>(
+    mode: Mode,
+    scene: &'a crate::Scene,
+    bvh: &'a bvh::Bvh,
+    octree: &'a crate::octree::Octree,
+) -> Box<dyn Visibility + 'a> {
+    match mode {
+        Mode::Brute => Box::new(Brute::new(scene)),
+        Mode::Octree => Box::new(OctreeVisibility::new(scene, octree)),
+        Mode::Bvh => Box::new(BvhVisibility::new(scene, bvh)),
+    }
+}

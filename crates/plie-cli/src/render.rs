@@ -1,0 +1,145 @@
+//! `plie render`: hit buffer + shading (SPEC §2) with a chosen visibility mode, written to PNG (tone-mapped
+//! sRGB), EXR or PFM (linear radiance).
+
+use std::path::PathBuf;
+use std::time::Instant;
+
+use anyhow::{Context, Result};
+use plie::octree::{Octree, OctreeParams};
+use plie::render::{render, RenderSettings};
+use plie::visibility::bvh::Bvh;
+use plie::visibility::{self, Mode};
+use serde_json::json;
+
+use crate::progress::Bar;
+use crate::scene_arg::SceneArgs;
+
+/// Options of `plie render`.
+#[derive(clap::Args)]
+pub struct Args {
+    #[command(flatten)]
+    scene: SceneArgs,
+    /// Output image; the extension picks the format: .png, .exr, .pfm.
+    #[arg(short = 'o', long = "output", value_name = "OUT")]
+    output: PathBuf,
+    /// Image width in pixels.
+    #[arg(long, default_value_t = 398)]
+    width: u32,
+    /// Image height in pixels.
+    #[arg(long, default_value_t = 398)]
+    height: u32,
+    /// K: K x K regular eye rays per pixel.
+    #[arg(long, default_value_t = 2, value_name = "K")]
+    eye_rays: u32,
+    /// N: N-rooks shadow rays per light per eye ray.
+    #[arg(long, default_value_t = 25, value_name = "N")]
+    shadow_rays: u32,
+    /// Visibility method.
+    #[arg(long, default_value = "octree", value_name = "MODE")]
+    visibility: Mode,
+    /// Seed of the random streams (same seed, same image, in every exact mode).
+    #[arg(long, default_value_t = 0)]
+    seed: u64,
+    /// Worker threads (default: all cores). Images do not depend on it.
+    #[arg(long, value_name = "T")]
+    threads: Option<usize>,
+    /// Octree: split leaves holding more triangles than this.
+    #[arg(long, default_value_t = 200, value_name = "N")]
+    max_triangles: usize,
+    /// Octree: maximum depth.
+    #[arg(long, default_value_t = OctreeParams::default().max_depth, value_name = "D")]
+    max_depth: u32,
+    /// Print human-readable figures on stderr.
+    #[arg(long)]
+    stats: bool,
+    /// Print one JSON object with the figures on stdout.
+    #[arg(long)]
+    json: bool,
+    /// No progress bar, no warnings.
+    #[arg(long, short)]
+    quiet: bool,
+}
+
+pub fn run(a: &Args) -> Result<()> {
+    crate::scenes::set_threads(a.threads)?;
+    let settings = RenderSettings {
+        width: a.width,
+        height: a.height,
+        eye_rays: a.eye_rays,
+        shadow_rays: a.shadow_rays,
+        seed: a.seed,
+    };
+    settings.validate()?;
+    let t = Instant::now();
+    let scene = a.scene.load()?;
+    let load_seconds = t.elapsed().as_secs_f64();
+    if scene.degenerate_skipped > 0 && !a.quiet {
+        eprintln!("warning: skipped {} degenerate (zero-area) triangles", scene.degenerate_skipped);
+    }
+    let camera = a.scene.camera(&scene)?;
+    plie::io::check_image_path(&a.output)?;
+
+    let t = Instant::now();
+    let bvh = Bvh::build(&scene);
+    let bvh_seconds = t.elapsed().as_secs_f64();
+    let t = Instant::now();
+    let params = OctreeParams { max_triangles: a.max_triangles, max_depth: a.max_depth };
+    params.validate()?;
+    let octree = Octree::build(&scene, params);
+    let octree_seconds = t.elapsed().as_secs_f64();
+
+    let vis = visibility::for_mode(a.visibility, &scene, &bvh, &octree);
+    let bar = Bar::new(a.quiet || a.json);
+    let out = render(&scene, &camera, &settings, &bvh, Some(&octree), vis.as_ref(), &bar)?;
+    plie::io::save_image(&a.output, a.width, a.height, &out.pixels)
+        .with_context(|| format!("cannot write {}", a.output.display()))?;
+
+    let s = out.stats;
+    let per_ray = if s.shadow_rays > 0 { s.triangle_tests as f64 / s.shadow_rays as f64 } else { 0.0 };
+    let rays_per_second = s.shadow_rays as f64 / out.shading_seconds.max(1e-9);
+    if a.json {
+        let v = json!({
+            "scene": scene.name,
+            "triangles": scene.triangle_count(),
+            "lights": scene.lights.len(),
+            "visibility": a.visibility.name(),
+            "width": a.width,
+            "height": a.height,
+            "eye_rays": a.eye_rays,
+            "shadow_rays_per_light": a.shadow_rays,
+            "seed": a.seed,
+            "threads": rayon::current_num_threads(),
+            "load_seconds": load_seconds,
+            "bvh_build_seconds": bvh_seconds,
+            "octree_build_seconds": octree_seconds,
+            "octree_leaves": octree.leaf_count(),
+            "octree_depth": octree.depth(),
+            "hit_buffer_seconds": out.hit_buffer_seconds,
+            "shading_seconds": out.shading_seconds,
+            "shadow_rays": s.shadow_rays,
+            "occluded": s.occluded,
+            "triangle_tests": s.triangle_tests,
+            "triangle_tests_per_shadow_ray": per_ray,
+            "shadow_rays_per_second": rays_per_second,
+            "output": a.output.display().to_string(),
+        });
+        println!("{v}");
+    }
+    if a.stats {
+        eprintln!("scene            {} ({} triangles, {} lights)", scene.name, scene.triangle_count(), scene.lights.len());
+        eprintln!("visibility       {}", a.visibility);
+        eprintln!("image            {}x{}, {}x{} eye rays/pixel, {} shadow rays/light", a.width, a.height, a.eye_rays, a.eye_rays, a.shadow_rays);
+        eprintln!("threads          {}", rayon::current_num_threads());
+        eprintln!("load             {load_seconds:.3} s");
+        eprintln!("bvh build        {bvh_seconds:.3} s");
+        eprintln!("octree build     {octree_seconds:.3} s ({} leaves, depth {})", octree.leaf_count(), octree.depth());
+        eprintln!("hit buffer       {:.3} s", out.hit_buffer_seconds);
+        eprintln!("shading          {:.3} s", out.shading_seconds);
+        eprintln!("shadow rays      {} ({:.1}% occluded, {:.2} M/s)", s.shadow_rays, 100.0 * s.occluded as f64 / s.shadow_rays.max(1) as f64, rays_per_second / 1e6);
+        eprintln!("triangle tests   {} ({per_ray:.2} per shadow ray)", s.triangle_tests);
+    }
+    if !a.quiet && !a.json && !a.stats {
+        eprintln!("wrote {} ({:.2} s shading, {} shadow rays)", a.output.display(), out.shading_seconds, s.shadow_rays);
+    }
+    Ok(())
+}

@@ -1,0 +1,74 @@
+//! `--scene NAME|FILE` and the camera options shared by subcommands.
+
+use std::path::Path;
+
+use anyhow::{bail, Context, Result};
+use glam::Vec3;
+use plie::scene::builtin;
+use plie::{Camera, Scene};
+
+/// Options that choose the scene and camera.
+#[derive(clap::Args, Clone, Debug)]
+pub struct SceneArgs {
+    /// A built-in scene name (see `plie scenes`) or a scene file (.obj with its .mtl, .gltf, .glb).
+    #[arg(long, value_name = "NAME|FILE")]
+    pub scene: String,
+    /// Camera position (default: the scene's camera).
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true)]
+    pub eye: Option<Vec3>,
+    /// Point the camera looks at.
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true)]
+    pub target: Option<Vec3>,
+    /// Camera up vector.
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true)]
+    pub up: Option<Vec3>,
+    /// Vertical field of view in degrees.
+    #[arg(long, value_name = "DEG")]
+    pub fov: Option<f32>,
+}
+
+impl SceneArgs {
+    /// Loads the scene: a built-in name, else a file.
+    pub fn load(&self) -> Result<Scene> {
+        if builtin::NAMES.contains(&self.scene.as_str()) {
+            return Ok(builtin::load(&self.scene)?);
+        }
+        let path = Path::new(&self.scene);
+        if !path.exists() {
+            if path.extension().is_none() {
+                return Err(builtin::load(&self.scene).unwrap_err().into());
+            }
+            bail!("{}: no such file", path.display());
+        }
+        plie::io::load_scene(path).with_context(|| format!("cannot load scene {}", path.display()))
+    }
+
+    /// The camera: the scene's (or a framing default), with any option given overriding a part.
+    pub fn camera(&self, scene: &Scene) -> Result<Camera> {
+        let base = scene.camera_or_default();
+        let c = Camera {
+            eye: self.eye.unwrap_or(base.eye),
+            target: self.target.unwrap_or(base.target),
+            up: self.up.unwrap_or(base.up),
+            fov_deg: self.fov.unwrap_or(base.fov_deg),
+        };
+        c.validate()?;
+        Ok(c)
+    }
+}
+
+/// Parses `X,Y,Z`.
+pub fn parse_vec3(s: &str) -> Result<Vec3, String> {
+    let parts: Vec<&str> = s.split(',').map(str::trim).collect();
+    if parts.len() != 3 {
+        return Err(format!("expected X,Y,Z, got '{s}'"));
+    }
+    let mut v = [0.0f32; 3];
+    for (o, p) in v.iter_mut().zip(&parts) {
+        *o = p.parse::<f32>().map_err(|_| format!("'{p}' is not a number"))?;
+        if !o.is_finite() {
+            return Err(format!("'{p}' is not finite"));
+        }
+    }
+    Ok(Vec3::from_array(v))
+}

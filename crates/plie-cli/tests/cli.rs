@@ -1,0 +1,140 @@
+//! The `plie` binary end to end: listing scenes, rendering, and bad input. Every bad input must give a
+//! one-line error naming the problem and a non-zero exit, never a panic.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn plie(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_plie")).args(args).output().expect("run plie")
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+/// Runs `plie args`, expects failure with a one-line error containing `needle`.
+fn fails_with(args: &[&str], needle: &str) {
+    let o = plie(args);
+    let err = stderr(&o);
+    assert!(!o.status.success(), "{args:?} should fail; stderr: {err}");
+    assert!(!err.contains("panicked"), "{args:?} panicked: {err}");
+    let lines: Vec<&str> = err.lines().filter(|l| !l.trim().is_empty()).collect();
+    assert_eq!(lines.len(), 1, "{args:?}: expected a one-line error, got: {err}");
+    assert!(
+        lines[0].to_lowercase().contains(&needle.to_lowercase()),
+        "{args:?}: error should mention '{needle}': {err}"
+    );
+}
+
+fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
+    let p = dir.join(name);
+    std::fs::write(&p, text).unwrap();
+    p
+}
+
+const GOOD_OBJ: &str = "mtllib box.mtl\nv 0 0 0\nv 1 0 0\nv 1 0 1\nv 0 0 1\nv 0 1 0\nv 0 1 1\nv 1 1 1\nv 1 1 0\n\
+usemtl white\nf 1 3 2\nf 1 4 3\nusemtl lamp\nf 5 8 7\nf 5 7 6\n";
+const GOOD_MTL: &str = "newmtl white\nKd 0.8 0.8 0.8\nnewmtl lamp\nKd 0 0 0\nKe 5 5 5\n";
+
+#[test]
+fn scenes_lists_ten_scenes() {
+    let o = plie(&["scenes"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let out = String::from_utf8_lossy(&o.stdout);
+    for name in ["cornell-cube-1", "cornell-cube-5", "huis-a", "huis-c", "dragon", "boot"] {
+        assert!(out.lines().any(|l| l.starts_with(name)), "missing {name} in {out}");
+    }
+    assert_eq!(out.lines().count(), 11, "header + ten scenes: {out}");
+}
+
+#[test]
+fn render_writes_png_and_json() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("c.png");
+    let o = plie(&[
+        "render", "--scene", "cornell-cube-2", "-o", out.to_str().unwrap(), "--width", "24", "--height", "20",
+        "--eye-rays", "1", "--shadow-rays", "2", "--json", "--visibility", "bvh",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).expect("one JSON object on stdout");
+    for key in ["scene", "triangles", "lights", "visibility", "width", "height", "hit_buffer_seconds",
+        "shading_seconds", "shadow_rays", "triangle_tests"] {
+        assert!(v.get(key).is_some(), "missing {key} in {v}");
+    }
+    assert_eq!(v["triangles"], 32);
+    assert_eq!(v["visibility"], "bvh");
+    assert!(v["shadow_rays"].as_u64().unwrap() > 0);
+    let bytes = std::fs::read(&out).unwrap();
+    assert_eq!(&bytes[1..4], b"PNG");
+}
+
+#[test]
+fn render_pfm_is_identical_for_every_mode() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut images = Vec::new();
+    for mode in ["brute", "octree", "bvh"] {
+        let out = dir.path().join(format!("{mode}.pfm"));
+        let o = plie(&[
+            "render", "--scene", "cornell-cube-1", "-o", out.to_str().unwrap(), "--width", "16", "--height", "16",
+            "--eye-rays", "1", "--shadow-rays", "3", "--visibility", mode, "--quiet", "--seed", "3",
+        ]);
+        assert!(o.status.success(), "{}", stderr(&o));
+        images.push(std::fs::read(&out).unwrap());
+    }
+    assert!(images[0].len() > 16 * 16 * 12);
+    assert_eq!(images[0], images[1]);
+    assert_eq!(images[0], images[2]);
+}
+
+#[test]
+fn bad_scene_files_give_one_line_errors() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    write(d, "box.mtl", GOOD_MTL);
+    let out = d.join("o.png");
+    let out = out.to_str().unwrap();
+    let cases: Vec<(PathBuf, &str)> = vec![
+        (write(d, "empty.obj", ""), "empty.obj"),
+        (write(d, "trunc.obj", &GOOD_OBJ[..GOOD_OBJ.len() - 4]), "trunc.obj"),
+        (write(d, "badnum.obj", &GOOD_OBJ.replace("v 1 0 1", "v 1 0x 1")), "badnum.obj"),
+        (write(d, "range.obj", &GOOD_OBJ.replace("f 1 3 2", "f 1 3 99")), "range.obj"),
+        (write(d, "nan.obj", &GOOD_OBJ.replace("v 1 0 1", "v 1 nan 1")), "nan.obj"),
+        (write(d, "inf.obj", &GOOD_OBJ.replace("v 1 0 1", "v 1 inf 1")), "inf.obj"),
+        (write(d, "nolight.obj", &GOOD_OBJ.replace("usemtl lamp", "usemtl white")), "light"),
+        (write(d, "nomtl.obj", &GOOD_OBJ.replace("box.mtl", "missing.mtl")), "missing.mtl"),
+        (write(d, "bad.gltf", "{ this is not json"), "bad.gltf"),
+        (write(d, "trunc.glb", "glTF\u{2}\0\0\0"), "trunc.glb"),
+        (write(d, "scene.xyz", "hello"), "scene.xyz"),
+    ];
+    for (path, needle) in cases {
+        fails_with(&["render", "--scene", path.to_str().unwrap(), "-o", out, "--width", "8", "--height", "8"], needle);
+    }
+    // A malformed MTL next to a good OBJ.
+    let d2 = tempfile::tempdir().unwrap();
+    write(d2.path(), "box.mtl", "newmtl white\nKd 0.8 zz 0.8\n");
+    let obj = write(d2.path(), "m.obj", GOOD_OBJ);
+    fails_with(&["render", "--scene", obj.to_str().unwrap(), "-o", out], "box.mtl");
+}
+
+#[test]
+fn unknown_scene_and_bad_output_give_one_line_errors() {
+    fails_with(&["render", "--scene", "no-such-scene", "-o", "/tmp/x.png"], "unknown scene");
+    fails_with(&["render", "--scene", "missing-file.obj", "-o", "/tmp/x.png"], "missing-file.obj");
+    let dir = tempfile::tempdir().unwrap();
+    let bad = dir.path().join("no/such/dir/out.png");
+    fails_with(&["render", "--scene", "cornell-cube-1", "-o", bad.to_str().unwrap(), "--width", "8", "--height", "8"], "out.png");
+    let bad = dir.path().join("out.bmp");
+    fails_with(&["render", "--scene", "cornell-cube-1", "-o", bad.to_str().unwrap(), "--width", "8", "--height", "8"], "out.bmp");
+    fails_with(&["render", "--scene", "cornell-cube-1", "-o", "/tmp/x.png", "--width", "0"], "size");
+    fails_with(&["render", "--scene", "cornell-cube-1", "-o", "/tmp/x.png", "--fov", "200"], "field of view");
+}
+
+#[test]
+fn existing_output_is_kept_when_rendering_fails() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = write(dir.path(), "keep.png", "precious");
+    let obj = write(dir.path(), "broken.obj", "v 0 0 0\nf 1 2 3\n");
+    let o = plie(&["render", "--scene", obj.to_str().unwrap(), "-o", out.to_str().unwrap()]);
+    assert!(!o.status.success());
+    assert_eq!(std::fs::read_to_string(&out).unwrap(), "precious");
+}

@@ -1,0 +1,230 @@
+//! Octree construction (SPEC §3; thesis §3.1.2, §5.1).
+//!
+//! The root is a cube centred on the scene's bounding box whose half-size is the largest half-extent
+//! grown by [`ROOT_MARGIN`] (plus a few `eps`), so no triangle lies on the root's boundary. The root is
+//! always split; any other cell with more than `max_triangles` triangles is split until `max_depth`.
+//! A triangle goes to every child whose box, grown by `eps`, it overlaps by the exact separating-axis
+//! test ([`triangle_overlaps_box`]); a cheap bounding-box pre-filter with a `2 eps` slack only skips
+//! children the exact test would reject too.
+//!
+//! The build runs level by level. For one level, the cells to split are split in parallel (rayon,
+//! and large triangle lists in parallel chunks); the results are then placed into the flat arrays by
+//! one sequential pass in cell order. Every value is a pure function of the scene and the parameters,
+//! and rayon's ordered `collect` keeps the chunk order, so the arrays are identical for any number of
+//! threads.
+
+use rayon::prelude::*;
+
+use super::{child_box, Leaf, LeafId, Node, Octree, OctreeParams};
+use crate::geometry::{triangle_overlaps_box, Aabb};
+use crate::scene::{Scene, TriId};
+
+/// Relative margin by which the root cube exceeds the scene's largest half-extent.
+pub const ROOT_MARGIN: f32 = 1e-3;
+
+/// Relative assignment tolerance: `eps = EPS_REL * max(scene.scale(), largest |coordinate|)`.
+pub const EPS_REL: f32 = 1e-6;
+
+/// Triangle lists longer than this are split in parallel chunks of this size.
+const PAR_CHUNK: usize = 4096;
+
+/// The assignment and traversal tolerance for a scene: `EPS_REL` times the larger of the scene's scale
+/// and its largest absolute coordinate. For scenes near the origin this is `scene.scale() * 1e-6`;
+/// for a scene far from the origin it stays several `f32` ulps of its coordinates wide, so rounding in
+/// the traversal can never close the margin.
+pub fn tolerance(scene: &Scene) -> f32 {
+    let b = scene.bounds;
+    let far = b.min.abs().max(b.max.abs()).max_element();
+    EPS_REL * scene.scale().max(far)
+}
+
+/// The root cube for a scene and tolerance.
+pub fn root_cube(scene: &Scene, eps: f32) -> Aabb {
+    let half = 0.5 * scene.bounds.size().max_element();
+    Aabb::cube(scene.bounds.center(), half * (1.0 + ROOT_MARGIN) + 4.0 * eps)
+}
+
+/// A cell waiting for its split decision: its node, box, depth and triangles.
+struct Pending {
+    node: u32,
+    bounds: Aabb,
+    depth: u32,
+    tris: Vec<TriId>,
+}
+
+/// The triangle lists of the 8 children of a cell.
+type Split = [Vec<TriId>; 8];
+
+impl Octree {
+    /// Builds the octree of `scene`. Deterministic: the same scene and parameters give the same arrays
+    /// for any number of rayon threads.
+    ///
+    /// # Panics
+    /// If `params` fails [`OctreeParams::validate`] (callers taking parameters from users validate
+    /// them first and report the error).
+    pub fn build(scene: &Scene, params: OctreeParams) -> Octree {
+        if let Err(e) = params.validate() {
+            panic!("Octree::build: {e}");
+        }
+        let eps = tolerance(scene);
+        let root = root_cube(scene, eps);
+        let n = scene.triangles.len();
+        assert!(n < u32::MAX as usize, "too many triangles for u32 ids");
+        let mut tree = Octree {
+            nodes: vec![Node::UNSET],
+            node_bounds: vec![root],
+            leaves: Vec::new(),
+            leaf_tris: Vec::new(),
+            eps,
+            params,
+            depth: 0,
+            scene_triangles: n,
+        };
+        let all = (0..n as u32).map(TriId).collect();
+        let mut frontier = vec![Pending { node: 0, bounds: root, depth: 0, tris: all }];
+        while !frontier.is_empty() {
+            let splits: Vec<Option<Split>> = frontier
+                .par_iter()
+                .map(|p| {
+                    let split = p.depth == 0 || (p.tris.len() > params.max_triangles && p.depth < params.max_depth);
+                    split.then(|| split_cell(scene, &p.tris, &p.bounds, eps))
+                })
+                .collect();
+            frontier = tree.place(frontier, splits);
+        }
+        tree.nodes.shrink_to_fit();
+        tree.node_bounds.shrink_to_fit();
+        tree.leaves.shrink_to_fit();
+        tree.leaf_tris.shrink_to_fit();
+        tree
+    }
+
+    /// Places one level: split cells become inner nodes with 8 new children (returned as the next
+    /// level), the others become leaves.
+    fn place(&mut self, frontier: Vec<Pending>, splits: Vec<Option<Split>>) -> Vec<Pending> {
+        let mut next = Vec::new();
+        for (p, split) in frontier.into_iter().zip(splits) {
+            match split {
+                Some(children) => {
+                    let first = self.nodes.len() as u32;
+                    self.nodes[p.node as usize] = Node::inner(first);
+                    for (i, tris) in children.into_iter().enumerate() {
+                        let bounds = child_box(&p.bounds, i);
+                        self.nodes.push(Node::UNSET);
+                        self.node_bounds.push(bounds);
+                        next.push(Pending { node: first + i as u32, bounds, depth: p.depth + 1, tris });
+                    }
+                }
+                None => {
+                    let id = LeafId(self.leaves.len() as u32);
+                    self.nodes[p.node as usize] = Node::leaf(id);
+                    let start = self.leaf_tris.len();
+                    self.leaf_tris.extend_from_slice(&p.tris);
+                    let end = self.leaf_tris.len();
+                    assert!(end <= u32::MAX as usize, "too many leaf triangle references for u32 ranges");
+                    self.leaves.push(Leaf { node: p.node, depth: p.depth, start: start as u32, end: end as u32 });
+                    self.depth = self.depth.max(p.depth);
+                }
+            }
+        }
+        next
+    }
+}
+
+/// Distributes a cell's triangles over its 8 children (each list keeps the parent's order).
+fn split_cell(scene: &Scene, tris: &[TriId], cell: &Aabb, eps: f32) -> Split {
+    let grown: [Aabb; 8] = std::array::from_fn(|i| child_box(cell, i).expanded(eps));
+    let center = cell.center();
+    if tris.len() <= PAR_CHUNK {
+        return split_chunk(scene, tris, &grown, center, eps);
+    }
+    let parts: Vec<Split> =
+        tris.par_chunks(PAR_CHUNK).map(|chunk| split_chunk(scene, chunk, &grown, center, eps)).collect();
+    std::array::from_fn(|i| {
+        let mut v = Vec::with_capacity(parts.iter().map(|p| p[i].len()).sum());
+        for p in &parts {
+            v.extend_from_slice(&p[i]);
+        }
+        v
+    })
+}
+
+/// Sequential part of [`split_cell`]: a bounding-box pre-filter against the split planes through
+/// `center` (slack `2 eps`, wider than the grown boxes) picks the candidate children, the exact test
+/// decides.
+fn split_chunk(scene: &Scene, tris: &[TriId], grown: &[Aabb; 8], center: glam::Vec3, eps: f32) -> Split {
+    let mut out: Split = Default::default();
+    let lo_limit = center + glam::Vec3::splat(2.0 * eps);
+    let hi_limit = center - glam::Vec3::splat(2.0 * eps);
+    for &t in tris {
+        let tri = scene.triangle(t);
+        let bb = tri.aabb();
+        // Bit k of `lower`/`upper`: the triangle may reach the lower/upper half along axis k.
+        let lower = bb.min.cmple(lo_limit).bitmask();
+        let upper = bb.max.cmpge(hi_limit).bitmask();
+        for (i, child) in grown.iter().enumerate() {
+            let i = i as u32;
+            // Axis k needs the upper half if bit k of i is set, the lower half otherwise.
+            let ok = (i & upper) | (!i & lower & 7);
+            if ok == 7 && triangle_overlaps_box(tri, child) {
+                out[i as usize].push(t);
+            }
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use glam::Vec3;
+
+    use super::*;
+    use crate::octree::NodeKind;
+    use crate::SceneBuilder;
+
+    fn two_triangle_scene() -> Scene {
+        let mut b = SceneBuilder::new("two");
+        let m = b.diffuse("grey", Vec3::splat(0.5));
+        b.triangle(Vec3::new(0.0, 0.0, 0.0), Vec3::new(1.0, 0.0, 0.0), Vec3::new(0.0, 1.0, 0.0), m);
+        b.light("light", &[Vec3::new(0.2, 2.0, 0.2), Vec3::new(0.4, 2.0, 0.2), Vec3::new(0.4, 2.0, 0.4)], Vec3::ONE);
+        b.build().expect("valid scene")
+    }
+
+    #[test]
+    fn root_is_split_even_when_small() {
+        let s = two_triangle_scene();
+        let o = Octree::build(&s, OctreeParams::default());
+        assert!(matches!(o.nodes[0].kind(), NodeKind::Inner(1)));
+        assert_eq!(o.leaf_count(), 8);
+        assert_eq!(o.depth(), 1);
+        let r = o.root_bounds();
+        assert!(r.min.cmplt(s.bounds.min).all() && r.max.cmpgt(s.bounds.max).all(), "margin around the scene");
+        let size = r.size();
+        assert_eq!(size.x, size.y);
+        assert_eq!(size.y, size.z);
+    }
+
+    #[test]
+    fn splits_until_limit_or_depth() {
+        let mut b = SceneBuilder::new("fan");
+        let m = b.diffuse("grey", Vec3::splat(0.5));
+        // 30 thin triangles sharing a vertex: they all meet in every cell around it.
+        for i in 0..30 {
+            let a = i as f32 * 0.2;
+            b.triangle(Vec3::ZERO, Vec3::new(a.cos(), a.sin(), 0.1), Vec3::new(a.cos(), a.sin(), -0.1), m);
+        }
+        b.light("light", &[Vec3::new(0.0, 2.0, 0.0), Vec3::new(0.1, 2.0, 0.0), Vec3::new(0.1, 2.0, 0.1)], Vec3::ONE);
+        let s = b.build().expect("valid scene");
+        let o = Octree::build(&s, OctreeParams { max_triangles: 4, max_depth: 5 });
+        assert_eq!(o.depth(), 5, "the shared vertex forces splitting to max_depth");
+        for l in o.leaves() {
+            assert!(o.leaf_triangles(l).len() <= 4 || o.leaf_depth(l) == 5);
+        }
+    }
+
+    #[test]
+    #[should_panic(expected = "max_triangles")]
+    fn rejects_zero_max_triangles() {
+        Octree::build(&two_triangle_scene(), OctreeParams { max_triangles: 0, max_depth: 3 });
+    }
+}

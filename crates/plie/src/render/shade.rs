@@ -1,0 +1,133 @@
+//! Pass 2 of SPEC §2, the one the thesis times: direct lighting at every hit-buffer point,
+//!
+//! `L(x -> eye) = L_e(x) + sum_i (A_i / N) sum_k L_e,i f_r(x) G(x, y_k) V(x, y_k)`,
+//!
+//! with `f_r = albedo / pi`, `G = cos(theta_x) cos(theta_y) / |x - y|^2` (zero when either cosine is
+//! not positive, and then no shadow ray is shot), and `N` N-rooks samples `y_k` per light. The order
+//! of floating-point operations depends only on the scene, the seed and the visibility *answers*, so
+//! exact visibility modes give bit-identical images.
+
+use std::f32::consts::FRAC_1_PI;
+
+use glam::{Vec2, Vec3};
+use rayon::prelude::*;
+
+use super::hit_buffer::{Hit, HitBuffer};
+use super::sampler::{n_rooks, Rng};
+use super::Progress;
+use crate::scene::{LightId, Scene};
+use crate::visibility::{QueryCtx, QueryStats, ShadowRay, Visibility};
+
+/// Per-thread scratch space for shading.
+pub struct ShadeScratch {
+    /// Visibility query context.
+    pub ctx: QueryCtx,
+    samples: Vec<Vec2>,
+    perm: Vec<u32>,
+}
+
+impl ShadeScratch {
+    /// Scratch space for `scene` with `n` samples per light.
+    pub fn new(scene: &Scene, n: u32) -> ShadeScratch {
+        ShadeScratch {
+            ctx: QueryCtx::new(scene.triangles.len()),
+            samples: vec![Vec2::ZERO; n as usize],
+            perm: Vec::with_capacity(n as usize),
+        }
+    }
+}
+
+/// Radiance toward the eye at one hit: emission (front side only) plus direct lighting from every
+/// light. `stream` identifies the eye ray (pixel and sub-ray index) for the random streams.
+pub fn shade_hit(
+    scene: &Scene,
+    vis: &dyn Visibility,
+    hit: &Hit,
+    seed: u64,
+    stream: (u64, u64),
+    s: &mut ShadeScratch,
+) -> Vec3 {
+    let material = scene.material_of(hit.tri);
+    let mut l = if hit.front { material.emission } else { Vec3::ZERO };
+    let f_r = material.albedo * FRAC_1_PI;
+    if f_r == Vec3::ZERO {
+        return l;
+    }
+    let x = hit.point;
+    let n_samples = s.samples.len();
+    for (i, light) in scene.lights.iter().enumerate() {
+        let mut rng = Rng::stream(seed, stream.0, stream.1, i as u64);
+        n_rooks(&mut rng, &mut s.samples, &mut s.perm);
+        let mut sum = 0.0f32;
+        for k in 0..n_samples {
+            let y = light.sample(s.samples[k]);
+            let d = y - x;
+            let dist2 = d.length_squared();
+            if !(dist2 > 0.0) {
+                continue;
+            }
+            let inv_len = dist2.sqrt().recip();
+            let cos_x = hit.normal.dot(d) * inv_len;
+            let cos_y = -light.normal.dot(d) * inv_len;
+            if cos_x <= 0.0 || cos_y <= 0.0 {
+                continue;
+            }
+            let ray = ShadowRay::new(x, y, LightId(i as u32), hit.tri, hit.leaf);
+            s.ctx.stats.shadow_rays += 1;
+            if vis.occluded(&ray, &mut s.ctx) {
+                s.ctx.stats.occluded += 1;
+                continue;
+            }
+            sum += cos_x * cos_y / dist2;
+        }
+        l += light.radiance * f_r * (light.area / n_samples as f32 * sum);
+    }
+    l
+}
+
+/// Shades the whole hit buffer: one radiance per pixel (the mean of its eye rays), row-major, top row
+/// first; and the summed query counters.
+pub fn shade(
+    scene: &Scene,
+    hits: &HitBuffer,
+    vis: &dyn Visibility,
+    shadow_rays: u32,
+    seed: u64,
+    progress: &dyn Progress,
+) -> (Vec<Vec3>, QueryStats) {
+    let w = hits.width as usize;
+    let per_pixel = (hits.k * hits.k) as usize;
+    let mut image = vec![Vec3::ZERO; w * hits.height as usize];
+    progress.start("shading", hits.height as u64);
+    let stats = image
+        .par_chunks_mut(w)
+        .enumerate()
+        .map_init(
+            || ShadeScratch::new(scene, shadow_rays),
+            |s, (py, row)| {
+                let before = s.ctx.stats;
+                for (px, out) in row.iter_mut().enumerate() {
+                    let pixel = py * w + px;
+                    let mut sum = Vec3::ZERO;
+                    for (j, hit) in hits.hits[pixel * per_pixel..(pixel + 1) * per_pixel].iter().enumerate() {
+                        if let Some(hit) = hit {
+                            sum += shade_hit(scene, vis, hit, seed, (pixel as u64, j as u64), s);
+                        }
+                    }
+                    *out = sum / per_pixel as f32;
+                }
+                progress.advance(1);
+                let mut delta = s.ctx.stats;
+                delta.shadow_rays -= before.shadow_rays;
+                delta.occluded -= before.occluded;
+                delta.triangle_tests -= before.triangle_tests;
+                delta
+            },
+        )
+        .reduce(QueryStats::default, |mut a, b| {
+            a += b;
+            a
+        });
+    progress.finish();
+    (image, stats)
+}

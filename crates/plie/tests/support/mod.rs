@@ -1,0 +1,62 @@
+//! Shared fixtures for the integration tests: a deterministic generator, the scenes to test on, and
+//! the real scenes in `../shared/scenes/` (skipped with a notice where that folder is absent).
+#![allow(dead_code)]
+
+use std::path::{Path, PathBuf};
+
+use glam::Vec3;
+use plie::Scene;
+
+/// splitmix64: deterministic, seedable, no dependency.
+pub struct TestRng(pub u64);
+
+impl TestRng {
+    pub fn next_u64(&mut self) -> u64 {
+        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+        z ^ (z >> 31)
+    }
+
+    /// Uniform in [0, 1).
+    pub fn f32(&mut self) -> f32 {
+        (self.next_u64() >> 40) as f32 / (1u64 << 24) as f32
+    }
+
+    /// Uniform in 0..n.
+    pub fn below(&mut self, n: usize) -> usize {
+        (self.next_u64() % n as u64) as usize
+    }
+
+    /// A uniform point in the box.
+    pub fn point_in(&mut self, min: Vec3, max: Vec3) -> Vec3 {
+        min + (max - min) * Vec3::new(self.f32(), self.f32(), self.f32())
+    }
+}
+
+/// The folder of real scenes shared beside the project, if present.
+pub fn shared_scenes() -> Option<PathBuf> {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/scenes");
+    if dir.is_dir() {
+        Some(dir)
+    } else {
+        eprintln!("notice: {} not found; skipping the tests on real scenes", dir.display());
+        None
+    }
+}
+
+/// The lit OBJ scenes of `../shared/scenes/` used by the test suite (conference-lit is for benchmarks).
+pub const SHARED_OBJS: [&str; 5] =
+    ["CornellBox-Original.obj", "cornell-dragon.obj", "boat-lit.obj", "cornell-bunny.obj", "cornell-dragon-100k.obj"];
+
+/// Loads the shared scenes that exist (empty where the folder is absent).
+pub fn load_shared() -> Vec<Scene> {
+    let Some(dir) = shared_scenes() else { return Vec::new() };
+    SHARED_OBJS.iter().map(|f| plie::io::load_scene(&dir.join(f)).unwrap_or_else(|e| panic!("{f}: {e}"))).collect()
+}
+
+/// Every built-in scene.
+pub fn builtins() -> Vec<Scene> {
+    plie::scene::builtin::NAMES.iter().map(|n| plie::scene::builtin::load(n).unwrap()).collect()
+}
