@@ -3,8 +3,13 @@
 //! millimetres), `huis` (Huis A, B, C, metres), `dragon` (Cornell Cube 2 with a creature), `boot` (a
 //! boat on the water, metres); the mesh helpers they share are in `shapes`.
 
+mod boot;
+mod chair;
 mod cornell;
+mod decor;
 mod dragon;
+mod furniture;
+mod huis;
 mod shapes;
 
 use super::{Scene, SceneBuilder};
@@ -32,10 +37,11 @@ pub fn load(name: &str) -> Result<Scene> {
         "cornell-cube-3" => cornell::cube3()?,
         "cornell-cube-4" => cornell::cube4()?,
         "cornell-cube-5" => cornell::cube5()?,
+        "huis-a" => huis::huis_a()?,
+        "huis-b" => huis::huis_b()?,
+        "huis-c" => huis::huis_c()?,
         "dragon" => dragon::dragon()?,
-        "huis-a" | "huis-b" | "huis-c" | "boot" => {
-            return Err(Error::InvalidScene(format!("built-in scene {name} is not modelled yet")))
-        }
+        "boot" => boot::boot()?,
         _ => return Err(Error::UnknownScene { name: name.to_string(), known: NAMES.join(", ") }),
     };
     builder.build()
