@@ -2,6 +2,7 @@
 //! One file per subcommand; errors get context here and end the process with a one-line message and
 //! exit code 1 (clap's usage errors exit with 2).
 
+mod build;
 mod progress;
 mod render;
 mod scene_arg;
@@ -23,6 +24,8 @@ enum Command {
     Scenes(scenes::Args),
     /// Render a scene with direct lighting from its area lights.
     Render(Box<render::Args>),
+    /// Build the P-LIE of a scene and save it (.plie).
+    Build(Box<build::Args>),
 }
 
 fn main() {
@@ -30,6 +33,7 @@ fn main() {
     let result = match cli.command {
         Command::Scenes(a) => scenes::run(&a),
         Command::Render(a) => render::run(&a),
+        Command::Build(a) => build::run(&a),
     };
     if let Err(e) = result {
         eprintln!("error: {}", one_line(&e));

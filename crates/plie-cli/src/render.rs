@@ -5,7 +5,9 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use anyhow::{Context, Result};
+use plie::lie::PlieParams;
 use plie::octree::{Octree, OctreeParams};
+
 use plie::render::{render, RenderSettings};
 use plie::visibility::bvh::Bvh;
 use plie::visibility::{self, Mode};
@@ -49,6 +51,9 @@ pub struct Args {
     /// Octree: maximum depth.
     #[arg(long, default_value_t = OctreeParams::default().max_depth, value_name = "D")]
     max_depth: u32,
+    /// Use this P-LIE file (from `plie build`) instead of building one (modes that need a P-LIE).
+    #[arg(long, value_name = "FILE.plie")]
+    plie: Option<PathBuf>,
     /// Print human-readable figures on stderr.
     #[arg(long)]
     stats: bool,
@@ -82,14 +87,25 @@ pub fn run(a: &Args) -> Result<()> {
     let t = Instant::now();
     let bvh = Bvh::build(&scene);
     let bvh_seconds = t.elapsed().as_secs_f64();
-    let t = Instant::now();
-    let params = OctreeParams { max_triangles: a.max_triangles, max_depth: a.max_depth };
-    params.validate()?;
-    let octree = Octree::build(&scene, params);
-    let octree_seconds = t.elapsed().as_secs_f64();
-
-    let vis = visibility::for_mode(a.visibility, &scene, &bvh, &octree);
     let bar = Bar::new(a.quiet || a.json);
+    let params = PlieParams { max_triangles: a.max_triangles, max_depth: a.max_depth };
+    params.octree().validate()?;
+    let t = Instant::now();
+    let (octree, plie, plie_seconds, load_plie_seconds) = match (&a.plie, a.visibility.needs_plie()) {
+        (Some(path), true) => {
+            let (octree, plie) = plie::io::plie_file::load_plie(path, &scene, Some(params))
+                .with_context(|| format!("cannot use P-LIE file {}", path.display()))?;
+            (octree, Some(plie), None, Some(t.elapsed().as_secs_f64()))
+        }
+        (_, needs) => {
+            let octree = Octree::build(&scene, params.octree());
+            let t = Instant::now();
+            let plie = needs.then(|| plie::construct::build(&scene, &octree, params, &bar).0);
+            (octree, plie, needs.then(|| t.elapsed().as_secs_f64()), None)
+        }
+    };
+    let octree_seconds = t.elapsed().as_secs_f64() - plie_seconds.unwrap_or(0.0);
+    let vis = visibility::for_mode(a.visibility, &scene, &bvh, &octree, plie.as_ref())?;
     let out = render(&scene, &camera, &settings, &bvh, Some(&octree), vis.as_ref(), &bar)?;
     plie::io::save_image(&a.output, a.width, a.height, &out.pixels)
         .with_context(|| format!("cannot write {}", a.output.display()))?;
@@ -114,6 +130,8 @@ pub fn run(a: &Args) -> Result<()> {
             "octree_build_seconds": octree_seconds,
             "octree_leaves": octree.leaf_count(),
             "octree_depth": octree.depth(),
+            "build_seconds": plie_seconds,
+            "plie_load_seconds": load_plie_seconds,
             "hit_buffer_seconds": out.hit_buffer_seconds,
             "shading_seconds": out.shading_seconds,
             "shadow_rays": s.shadow_rays,
@@ -133,6 +151,12 @@ pub fn run(a: &Args) -> Result<()> {
         eprintln!("load             {load_seconds:.3} s");
         eprintln!("bvh build        {bvh_seconds:.3} s");
         eprintln!("octree build     {octree_seconds:.3} s ({} leaves, depth {})", octree.leaf_count(), octree.depth());
+        if let Some(s) = plie_seconds {
+            eprintln!("p-lie build      {s:.3} s");
+        }
+        if let Some(s) = load_plie_seconds {
+            eprintln!("p-lie load       {s:.3} s");
+        }
         eprintln!("hit buffer       {:.3} s", out.hit_buffer_seconds);
         eprintln!("shading          {:.3} s", out.shading_seconds);
         eprintln!("shadow rays      {} ({:.1}% occluded, {:.2} M/s)", s.shadow_rays, 100.0 * s.occluded as f64 / s.shadow_rays.max(1) as f64, rays_per_second / 1e6);

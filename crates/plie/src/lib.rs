@@ -8,10 +8,13 @@
 
 pub mod error;
 pub mod geometry;
+pub mod io;
 pub mod scene;
 
 pub use error::{Error, Result};
 pub use scene::{Camera, Light, LightId, Material, MaterialId, Scene, SceneBuilder, TriId};
+pub mod construct;
+pub mod lie;
 pub mod octree;
 pub mod visibility;
 pub mod render;

@@ -4,20 +4,19 @@
 mod support;
 
 use glam::Vec3;
-use plie::octree::{Octree, OctreeParams};
+use plie::lie::PlieParams;
 use plie::render::{render, NoProgress, RenderSettings};
-use plie::visibility::bvh::Bvh;
-use plie::visibility::{for_mode, Mode};
+use plie::visibility::Mode;
 use plie::Scene;
+use support::Built;
 
 fn image(scene: &Scene, mode: Mode, threads: usize, settings: &RenderSettings) -> Vec<Vec3> {
     let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
     pool.install(|| {
-        let bvh = Bvh::build(scene);
-        let octree = Octree::build(scene, OctreeParams::default());
-        let vis = for_mode(mode, scene, &bvh, &octree);
+        let built = Built::new(scene, PlieParams::thesis());
+        let vis = built.vis(scene, mode);
         let camera = scene.camera_or_default();
-        render(scene, &camera, settings, &bvh, Some(&octree), vis.as_ref(), &NoProgress).unwrap().pixels
+        render(scene, &camera, settings, &built.bvh, Some(&built.octree), vis.as_ref(), &NoProgress).unwrap().pixels
     })
 }
 

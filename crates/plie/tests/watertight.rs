@@ -4,9 +4,8 @@
 mod support;
 
 use glam::Vec3;
-use plie::octree::{Octree, OctreeParams};
-use plie::visibility::bvh::Bvh;
-use plie::visibility::{for_mode, Mode, QueryCtx, ShadowRay};
+use plie::lie::PlieParams;
+use plie::visibility::{Mode, QueryCtx, ShadowRay};
 use plie::{LightId, SceneBuilder, TriId};
 use support::TestRng;
 
@@ -45,8 +44,7 @@ fn sphere(rings: usize, segments: usize) -> (plie::Scene, Vec<Vec3>, Vec<(Vec3, 
 #[test]
 fn rays_through_shared_vertices_and_edges_never_slip_through() {
     let (scene, verts, edges) = sphere(17, 23);
-    let bvh = Bvh::build(&scene);
-    let octree = Octree::build(&scene, OctreeParams { max_triangles: 16, ..Default::default() });
+    let built = support::Built::new(&scene, PlieParams { max_triangles: 16, ..PlieParams::thesis() });
     let center = Vec3::new(0.3, -0.2, 0.1);
     let mut rng = TestRng(5);
     let mut targets: Vec<Vec3> = verts.clone();
@@ -55,8 +53,9 @@ fn rays_through_shared_vertices_and_edges_never_slip_through() {
         let t = rng.f32();
         targets.push(*a + (*b - *a) * t);
     }
-    for mode in Mode::ALL {
-        let vis = for_mode(mode, &scene, &bvh, &octree);
+    // Free segments (not toward a light sample): every mode that does not use a P-LIE.
+    for mode in Mode::ALL.into_iter().filter(|m| !m.needs_plie()) {
+        let vis = built.vis(&scene, mode);
         let mut ctx = QueryCtx::new(scene.triangles.len());
         for p in &targets {
             // From far outside, through the target, to the center: must cross the closed surface.
@@ -66,7 +65,7 @@ fn rays_through_shared_vertices_and_edges_never_slip_through() {
             // And along an axis-parallel direction through the same point.
             let from = *p + Vec3::new(0.0, 5.0, 0.0);
             let ray = ShadowRay::new(from, center + (*p - center) * 0.5 - Vec3::Y * 5.0, LightId(0), TriId(u32::MAX), None);
-            let brute = for_mode(Mode::Brute, &scene, &bvh, &octree).occluded(&ray, &mut ctx);
+            let brute = built.vis(&scene, Mode::Brute).occluded(&ray, &mut ctx);
             assert_eq!(vis.occluded(&ray, &mut ctx), brute, "{mode}: disagrees with brute force");
         }
     }

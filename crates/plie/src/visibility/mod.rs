@@ -5,12 +5,14 @@
 
 pub mod brute;
 pub mod bvh;
+pub mod lie;
 pub mod mode;
 pub mod octree;
 pub mod query;
 
 pub use brute::Brute;
 pub use bvh::BvhVisibility;
+pub use lie::LieVisibility;
 pub use mode::Mode;
 pub use octree::OctreeVisibility;
 pub use query::{blocks, QueryCtx, QueryStats, ShadowRay};
@@ -22,16 +24,22 @@ pub trait Visibility: Sync {
     fn occluded(&self, ray: &ShadowRay, ctx: &mut QueryCtx) -> bool;
 }
 
-/// The visibility method for `mode`, over the structures already built.
+/// The visibility method for `mode`, over the structures already built. Fails if `mode` needs a
+/// P-LIE and none is given.
 pub fn for_mode<'a>(
     mode: Mode,
     scene: &'a crate::Scene,
     bvh: &'a bvh::Bvh,
     octree: &'a crate::octree::Octree,
-) -> Box<dyn Visibility + 'a> {
-    match mode {
+    plie: Option<&'a crate::lie::Plie>,
+) -> crate::Result<Box<dyn Visibility + 'a>> {
+    Ok(match mode {
         Mode::Brute => Box::new(Brute::new(scene)),
         Mode::Octree => Box::new(OctreeVisibility::new(scene, octree)),
         Mode::Bvh => Box::new(BvhVisibility::new(scene, bvh)),
-    }
+        Mode::Lie => {
+            let plie = plie.ok_or_else(|| crate::Error::InvalidParameter(format!("mode {mode} needs a P-LIE")))?;
+            Box::new(LieVisibility::new(scene, octree, plie))
+        }
+    })
 }

@@ -13,11 +13,13 @@ pub enum Mode {
     Octree,
     /// A modern BVH (the peer).
     Bvh,
+    /// SPEC §5 mode (b): the P-LIE's blocker lists.
+    Lie,
 }
 
 impl Mode {
     /// Every mode, for tests that compare them all.
-    pub const ALL: [Mode; 3] = [Mode::Brute, Mode::Octree, Mode::Bvh];
+    pub const ALL: [Mode; 4] = [Mode::Brute, Mode::Octree, Mode::Bvh, Mode::Lie];
 
     /// The name used on the command line.
     pub fn name(self) -> &'static str {
@@ -25,7 +27,13 @@ impl Mode {
             Mode::Brute => "brute",
             Mode::Octree => "octree",
             Mode::Bvh => "bvh",
+            Mode::Lie => "lie",
         }
+    }
+
+    /// True if the mode answers from a P-LIE.
+    pub fn needs_plie(self) -> bool {
+        matches!(self, Mode::Lie)
     }
 }
 

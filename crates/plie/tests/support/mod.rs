@@ -60,3 +60,23 @@ pub fn load_shared() -> Vec<Scene> {
 pub fn builtins() -> Vec<Scene> {
     plie::scene::builtin::NAMES.iter().map(|n| plie::scene::builtin::load(n).unwrap()).collect()
 }
+
+/// Every structure a visibility mode may need, built for one scene.
+pub struct Built {
+    pub bvh: plie::visibility::bvh::Bvh,
+    pub octree: plie::octree::Octree,
+    pub plie: plie::lie::Plie,
+}
+
+impl Built {
+    pub fn new(scene: &Scene, params: plie::lie::PlieParams) -> Built {
+        let bvh = plie::visibility::bvh::Bvh::build(scene);
+        let octree = plie::octree::Octree::build(scene, params.octree());
+        let (plie, _) = plie::construct::build(scene, &octree, params, &plie::render::NoProgress);
+        Built { bvh, octree, plie }
+    }
+
+    pub fn vis<'a>(&'a self, scene: &'a Scene, mode: plie::visibility::Mode) -> Box<dyn plie::visibility::Visibility + 'a> {
+        plie::visibility::for_mode(mode, scene, &self.bvh, &self.octree, Some(&self.plie)).unwrap()
+    }
+}

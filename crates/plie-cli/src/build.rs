@@ -1,0 +1,94 @@
+//! `plie build`: construct the P-LIE of a scene (SPEC §4) for every leaf, face and light, independent of
+//! any camera, and save it as a `.plie` file.
+
+use std::path::PathBuf;
+use std::time::Instant;
+
+use anyhow::{Context, Result};
+use plie::lie::PlieParams;
+use plie::octree::{Octree, OctreeParams};
+use serde_json::json;
+
+use crate::progress::Bar;
+use crate::scene_arg::SceneArgs;
+
+/// Options of `plie build`.
+#[derive(clap::Args)]
+pub struct Args {
+    #[command(flatten)]
+    scene: SceneArgs,
+    /// Output file (.plie).
+    #[arg(short = 'o', long = "output", value_name = "OUT.plie")]
+    output: PathBuf,
+    /// Octree: split leaves holding more triangles than this.
+    #[arg(long, default_value_t = 200, value_name = "N")]
+    max_triangles: usize,
+    /// Octree: maximum depth.
+    #[arg(long, default_value_t = OctreeParams::default().max_depth, value_name = "D")]
+    max_depth: u32,
+    /// Worker threads (default: all cores). The result does not depend on it.
+    #[arg(long, value_name = "T")]
+    threads: Option<usize>,
+    /// Print one JSON object with the figures on stdout.
+    #[arg(long)]
+    json: bool,
+    /// No progress bar, no summary.
+    #[arg(long, short)]
+    quiet: bool,
+}
+
+pub fn run(a: &Args) -> Result<()> {
+    crate::scenes::set_threads(a.threads)?;
+    let scene = a.scene.load()?;
+    let params = PlieParams { max_triangles: a.max_triangles, max_depth: a.max_depth };
+    params.octree().validate()?;
+    let bar = Bar::new(a.quiet || a.json);
+    let t_all = Instant::now();
+    let t = Instant::now();
+    let octree = Octree::build(&scene, params.octree());
+    let octree_seconds = t.elapsed().as_secs_f64();
+    let (plie, mut stats) = plie::construct::build(&scene, &octree, params, &bar);
+    stats.octree_seconds = octree_seconds;
+    let build_seconds = t_all.elapsed().as_secs_f64();
+    let t = Instant::now();
+    let file_bytes = plie::io::plie_file::save_plie(&a.output, &scene, &octree, &plie)
+        .with_context(|| format!("cannot write {}", a.output.display()))?;
+    let write_seconds = t.elapsed().as_secs_f64();
+    let memory = plie.memory_bytes() + octree.memory_bytes();
+    if a.json {
+        let v = json!({
+            "scene": scene.name,
+            "triangles": scene.triangle_count(),
+            "lights": scene.lights.len(),
+            "max_triangles": a.max_triangles,
+            "max_depth": a.max_depth,
+            "threads": rayon::current_num_threads(),
+            "build_seconds": build_seconds,
+            "octree_seconds": octree_seconds,
+            "blockers_seconds": stats.blockers_seconds,
+            "write_seconds": write_seconds,
+            "leaves": octree.leaf_count(),
+            "depth": octree.depth(),
+            "faces_considered": stats.faces_considered,
+            "records": stats.records,
+            "records_removed_face_cannot_see_light": stats.no_record_face_cannot_see_light,
+            "candidates_clipped": stats.candidates_clipped,
+            "blockers_total": stats.blockers_total,
+            "blockers_mean": stats.blockers_mean,
+            "blockers_max": stats.blockers_max,
+            "bytes": memory,
+            "file_bytes": file_bytes,
+            "output": a.output.display().to_string(),
+        });
+        println!("{v}");
+    } else if !a.quiet {
+        println!("scene           {} ({} triangles, {} lights)", scene.name, scene.triangle_count(), scene.lights.len());
+        println!("octree          {} leaves, depth {} ({:.3} s)", octree.leaf_count(), octree.depth(), octree_seconds);
+        println!("data objects    {} of {} (leaf, face, light); {} without: the face cannot see the light", stats.records, stats.faces_considered, stats.no_record_face_cannot_see_light);
+        println!("blockers        {} in all, {:.1} per record (max {}), {} candidates clipped ({:.3} s)", stats.blockers_total, stats.blockers_mean, stats.blockers_max, stats.candidates_clipped, stats.blockers_seconds);
+        println!("build           {build_seconds:.3} s");
+        println!("memory          {memory} bytes (octree {} + P-LIE {})", octree.memory_bytes(), plie.memory_bytes());
+        println!("file            {} ({file_bytes} bytes, written in {write_seconds:.3} s)", a.output.display());
+    }
+    Ok(())
+}

@@ -1,0 +1,174 @@
+//! The shaft between a cell face and a light (SPEC §4.2, §4.3): the bounding volume (the box around
+//! face and light) and the supporting planes of `S = conv(face ∪ light)`.
+//!
+//! The thesis builds four planes, each through one face edge and one light vertex chosen by angle.
+//! We take SPEC §4.3's exact alternative: every supporting plane of the convex hull of the at most
+//! `4 + k` points, found by testing each triple of points (all points must lie on one side). A flat
+//! hull (light in the face's plane) simply yields fewer planes, i.e. a larger set — never a smaller
+//! one. Each plane is moved outward by a tolerance, so the kept set contains `S` grown by it: clipping
+//! can only err toward keeping a blocker.
+
+use glam::{DVec3, Vec3};
+
+use crate::geometry::Aabb;
+
+/// Most points a shaft is built from (4 face corners + light vertices); longer light polygons are
+/// bounded by their box planes only beyond this.
+pub const MAX_POINTS: usize = 16;
+
+/// A closed half-space `n . p <= d`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Plane {
+    /// Outward unit normal.
+    pub n: DVec3,
+    /// Offset.
+    pub d: f64,
+}
+
+impl Plane {
+    /// Signed distance of `p` beyond the plane (positive: outside).
+    #[inline]
+    pub fn distance(&self, p: DVec3) -> f64 {
+        self.n.dot(p) - self.d
+    }
+}
+
+/// The shaft from a face to a light: bounding volume and supporting planes, both grown by `tol`.
+#[derive(Clone, Debug)]
+pub struct Shaft {
+    /// Box around face and light, grown by the tolerance.
+    pub bounds: Aabb,
+    /// The hull's supporting planes, each moved outward by the tolerance, followed by the six planes of
+    /// `bounds`.
+    pub planes: Vec<Plane>,
+}
+
+impl Shaft {
+    /// The shaft of `conv(face ∪ light)`, grown by `tol`.
+    pub fn new(face: &[Vec3; 4], light: &[Vec3], tol: f32) -> Shaft {
+        let mut pts: Vec<DVec3> = face.iter().map(|p| p.as_dvec3()).collect();
+        pts.extend(light.iter().take(MAX_POINTS - 4).map(|p| p.as_dvec3()));
+        let bounds = Aabb::from_points(face.iter().chain(light)).expanded(tol);
+        let tol = tol as f64;
+        let scale = pts.iter().fold(0.0f64, |m, p| m.max(p.abs().max_element())).max(1e-30);
+        let mut planes: Vec<Plane> = Vec::new();
+        let n = pts.len();
+        for i in 0..n {
+            for j in i + 1..n {
+                for k in j + 1..n {
+                    let normal = (pts[j] - pts[i]).cross(pts[k] - pts[i]);
+                    let len = normal.length();
+                    if !(len > 1e-12 * scale * scale) {
+                        continue;
+                    }
+                    let nn = normal / len;
+                    let d = nn.dot(pts[i]);
+                    let slack = 1e-9 * scale;
+                    let (lo, hi) = pts.iter().fold((f64::MAX, f64::MIN), |(lo, hi), p| {
+                        let s = nn.dot(*p) - d;
+                        (lo.min(s), hi.max(s))
+                    });
+                    let cand = if hi <= slack {
+                        Plane { n: nn, d: d + hi.max(0.0) }
+                    } else if lo >= -slack {
+                        Plane { n: -nn, d: -d - lo.min(0.0) }
+                    } else {
+                        continue;
+                    };
+                    if !planes.iter().any(|p| p.n.dot(cand.n) > 1.0 - 1e-12 && (p.d - cand.d).abs() <= slack) {
+                        planes.push(cand);
+                    }
+                }
+            }
+        }
+        for p in &mut planes {
+            p.d += tol;
+        }
+        for k in 0..3 {
+            let mut e = DVec3::ZERO;
+            e[k] = 1.0;
+            planes.push(Plane { n: e, d: bounds.max[k] as f64 });
+            planes.push(Plane { n: -e, d: -(bounds.min[k] as f64) });
+        }
+        Shaft { bounds, planes }
+    }
+
+    /// False if the box lies entirely outside one of the planes (then nothing in it touches the shaft).
+    pub fn may_overlap_box(&self, b: &Aabb) -> bool {
+        let c = b.center().as_dvec3();
+        let h = (b.size() * 0.5).as_dvec3();
+        self.planes.iter().all(|p| p.distance(c) - h.dot(p.n.abs()) <= 0.0)
+    }
+
+    /// True if the triangle has a non-empty intersection with the (grown) shaft: Sutherland-Hodgman
+    /// clipping of the triangle by every plane (SPEC §4.4 step 3).
+    pub fn clips_triangle(&self, tri: &[Vec3; 3]) -> bool {
+        let mut buf_a = [DVec3::ZERO; 3 + 2 * MAX_POINTS * MAX_POINTS];
+        let mut buf_b = buf_a;
+        let mut len = 3;
+        for (o, v) in buf_a.iter_mut().zip(tri) {
+            *o = v.as_dvec3();
+        }
+        let (mut cur, mut next) = (&mut buf_a, &mut buf_b);
+        for p in &self.planes {
+            let mut out = 0;
+            for i in 0..len {
+                let a = cur[i];
+                let b = cur[(i + 1) % len];
+                let (da, db) = (p.distance(a), p.distance(b));
+                if da <= 0.0 {
+                    if out < next.len() {
+                        next[out] = a;
+                        out += 1;
+                    }
+                }
+                if (da <= 0.0) != (db <= 0.0) && out < next.len() {
+                    let t = da / (da - db);
+                    next[out] = a + (b - a) * t;
+                    out += 1;
+                }
+            }
+            if out == 0 {
+                return false;
+            }
+            std::mem::swap(&mut cur, &mut next);
+            len = out;
+        }
+        true
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn unit_face() -> [Vec3; 4] {
+        [Vec3::new(0.0, 1.0, 0.0), Vec3::new(0.0, 1.0, 1.0), Vec3::new(1.0, 1.0, 1.0), Vec3::new(1.0, 1.0, 0.0)]
+    }
+
+    #[test]
+    fn shaft_contains_segments_from_face_to_light_and_excludes_far_points() {
+        let light = [Vec3::new(2.0, 5.0, 2.0), Vec3::new(3.0, 5.0, 2.0), Vec3::new(3.0, 5.0, 3.0)];
+        let s = Shaft::new(&unit_face(), &light, 1e-5);
+        // Segment points from face points to light points are inside every plane.
+        for (f, l) in [(unit_face()[0], light[0]), (unit_face()[2], light[1]), (Vec3::new(0.5, 1.0, 0.5), light[2])] {
+            for i in 0..=10 {
+                let p = (f + (l - f) * (i as f32 / 10.0)).as_dvec3();
+                assert!(s.planes.iter().all(|pl| pl.distance(p) <= 1e-9), "{p}");
+            }
+        }
+        // A small triangle far off the shaft is not a blocker; one across it is.
+        let off = [Vec3::new(-3.0, 3.0, 3.0), Vec3::new(-2.9, 3.0, 3.0), Vec3::new(-3.0, 3.0, 3.1)];
+        assert!(!s.clips_triangle(&off));
+        let across = [Vec3::new(-10.0, 3.0, -10.0), Vec3::new(10.0, 3.0, -10.0), Vec3::new(0.0, 3.0, 10.0)];
+        assert!(s.clips_triangle(&across));
+    }
+
+    #[test]
+    fn coplanar_light_gives_a_conservative_flat_shaft() {
+        let light = [Vec3::new(3.0, 1.0, 0.0), Vec3::new(4.0, 1.0, 0.0), Vec3::new(4.0, 1.0, 1.0)];
+        let s = Shaft::new(&unit_face(), &light, 1e-5);
+        let on = [Vec3::new(2.0, 0.5, 0.5), Vec3::new(2.0, 1.5, 0.5), Vec3::new(2.0, 1.0, 0.7)];
+        assert!(s.clips_triangle(&on));
+    }
+}

@@ -1,0 +1,319 @@
+//! glTF 2.0 scenes (`.gltf` with external or embedded buffers, `.glb`), SPEC §1 scene model, read with
+//! the `gltf` crate.
+//!
+//! What is read: every mesh primitive of the default scene (or the first scene) with its node transform
+//! applied, in world space; modes TRIANGLES, TRIANGLE_STRIP and TRIANGLE_FAN, indexed or not; a node
+//! transform with negative determinant flips the winding (glTF rule). Material: base colour factor as
+//! albedo (textures ignored), `emissiveFactor` x `KHR_materials_emissive_strength` as emitted radiance;
+//! primitives without material get a grey default (albedo 0.8). The first perspective camera met in a
+//! depth-first walk of the scene becomes the scene camera (position, `-z` as view direction and `+y` as
+//! up from its node transform, `yfov` in degrees).
+//!
+//! Errors name the file and what is wrong (JSON syntax errors also the line). The `gltf` crate trusts
+//! accessor types and ranges (it panics or asserts on bad ones), so every accessor is checked first:
+//! type, count, stride and byte range within its buffer view and buffer. Sparse accessors, quantized
+//! (non-float) positions and point/line primitives are rejected with a clear error.
+
+use std::path::Path;
+
+use ::gltf::accessor::{DataType, Dimensions};
+use ::gltf::mesh::Mode;
+use ::gltf::{Accessor, Document, Semantic};
+use glam::{Mat4, Vec3};
+
+use super::lights::{self, EmissiveTriangle};
+use super::{parse_error, scene_name};
+use crate::error::{Error, Result};
+use crate::scene::{Camera, Material, MaterialId, Scene, SceneBuilder};
+
+/// Loads a `.gltf` or `.glb` file (see the module doc).
+pub fn load_gltf(path: &Path) -> Result<Scene> {
+    let bad = |m: String| parse_error(path, None, m);
+    let bytes = std::fs::read(path).map_err(|source| Error::Io { path: path.to_path_buf(), source })?;
+    if bytes.is_empty() {
+        return Err(bad("the file is empty".into()));
+    }
+    check_glb_header(&bytes).map_err(bad)?;
+    let gltf = ::gltf::Gltf::from_slice(&bytes).map_err(|e| gltf_error(path, e))?;
+    let buffers = load_buffers(path, &gltf.document, gltf.blob.clone())?;
+    let doc = &gltf.document;
+    let scene =
+        doc.default_scene().or_else(|| doc.scenes().next()).ok_or_else(|| bad("the file has no scene".into()))?;
+    let mut loader = Loader {
+        builder: SceneBuilder::new(&scene_name(path)),
+        buffers: &buffers,
+        materials: vec![None; doc.materials().len() + 1],
+        emissive: Vec::new(),
+        emissive_info: Vec::new(),
+        camera: None,
+    };
+    let mut seen = vec![false; doc.nodes().len()];
+    let mut stack: Vec<(::gltf::Node, Mat4)> = scene.nodes().map(|n| (n, Mat4::IDENTITY)).collect();
+    stack.reverse();
+    while let Some((node, parent)) = stack.pop() {
+        if std::mem::replace(&mut seen[node.index()], true) {
+            return Err(bad(format!(
+                "node {} appears twice in the scene graph (a cycle or two parents)",
+                node.index()
+            )));
+        }
+        let world = parent * Mat4::from_cols_array_2d(&node.transform().matrix());
+        if let Some(mesh) = node.mesh() {
+            for prim in mesh.primitives() {
+                loader.primitive(&mesh, &prim, world).map_err(|m| bad(format!("{}: {m}", describe(&mesh, &prim))))?;
+            }
+        }
+        if loader.camera.is_none() {
+            loader.camera(&node, world).map_err(bad)?;
+        }
+        stack.extend(node.children().map(|c| (c, world)).collect::<Vec<_>>().into_iter().rev());
+    }
+    loader.finish(path)
+}
+
+/// "mesh 'name' (mesh 2), primitive 0" for error messages.
+fn describe(mesh: &::gltf::Mesh, prim: &::gltf::Primitive) -> String {
+    let name = mesh.name().map(|n| format!("mesh '{n}' (mesh {})", mesh.index()));
+    format!("{}, primitive {}", name.unwrap_or_else(|| format!("mesh {}", mesh.index())), prim.index())
+}
+
+/// An error of the `gltf` crate as a parse error (with the JSON line for syntax errors).
+fn gltf_error(path: &Path, e: ::gltf::Error) -> Error {
+    match e {
+        ::gltf::Error::Deserialize(e) => {
+            parse_error(path, (e.line() > 0).then_some(e.line()), format!("malformed glTF JSON: {e}"))
+        }
+        ::gltf::Error::Validation(errors) => {
+            let list: Vec<String> = errors.iter().take(5).map(|(p, e)| format!("{}: {e}", p.as_str())).collect();
+            parse_error(path, None, format!("invalid glTF: {}", list.join("; ")))
+        }
+        e => parse_error(path, None, format!("invalid glTF: {e}")),
+    }
+}
+
+/// The `gltf` crate subtracts the header size from the GLB's length field unchecked (an overflow
+/// panic in debug builds): check the header first.
+fn check_glb_header(bytes: &[u8]) -> Result<(), String> {
+    if !bytes.starts_with(b"glTF") {
+        return Ok(());
+    }
+    let Some(length) = bytes.get(8..12) else { return Err("truncated GLB header".into()) };
+    let length = u32::from_le_bytes([length[0], length[1], length[2], length[3]]);
+    if length < 20 || length as usize > bytes.len() {
+        return Err(format!("GLB header says {length} bytes, but the file has {}", bytes.len()));
+    }
+    Ok(())
+}
+
+/// Reads every buffer (GLB chunk, data URI or external file), naming the buffer that fails.
+fn load_buffers(path: &Path, doc: &Document, mut blob: Option<Vec<u8>>) -> Result<Vec<::gltf::buffer::Data>> {
+    let base = path.parent().unwrap_or(Path::new("."));
+    let mut out = Vec::new();
+    for buffer in doc.buffers() {
+        let what = match buffer.source() {
+            ::gltf::buffer::Source::Uri(uri) if uri.starts_with("data:") => {
+                format!("buffer {} (data URI)", buffer.index())
+            }
+            ::gltf::buffer::Source::Uri(uri) => format!("buffer {} ('{}')", buffer.index(), base.join(uri).display()),
+            ::gltf::buffer::Source::Bin => format!("buffer {} (GLB binary chunk)", buffer.index()),
+        };
+        // The crate unwraps the percent-decoding of relative URIs: check it first.
+        if let ::gltf::buffer::Source::Uri(uri) = buffer.source() {
+            if !uri.contains(':') && urlencoding::decode(uri).is_err() {
+                return Err(parse_error(path, None, format!("{what}: the URI is not UTF-8 after percent-decoding")));
+            }
+        }
+        let data = ::gltf::buffer::Data::from_source_and_blob(buffer.source(), Some(base), &mut blob)
+            .map_err(|e| parse_error(path, None, format!("cannot load {what}: {e}")))?;
+        if data.len() < buffer.length() {
+            let m = format!("{what} has {} bytes, but byteLength is {}", data.len(), buffer.length());
+            return Err(parse_error(path, None, m));
+        }
+        out.push(data);
+    }
+    Ok(out)
+}
+
+/// Checks that the `gltf` crate can read `acc` safely: not sparse, count >= 1, a type `ok` accepts, a
+/// stride no smaller than an element, and every byte inside its buffer view and buffer.
+fn check_accessor(
+    acc: &Accessor,
+    buffers: &[::gltf::buffer::Data],
+    expected: &str,
+    ok: impl Fn(DataType, Dimensions) -> bool,
+) -> Result<(), String> {
+    let i = acc.index();
+    if acc.sparse().is_some() {
+        return Err(format!("accessor {i} is sparse; sparse accessors are not supported"));
+    }
+    if !ok(acc.data_type(), acc.dimensions()) {
+        return Err(format!("accessor {i} is {:?} of {:?}; expected {expected}", acc.dimensions(), acc.data_type()));
+    }
+    let Some(view) = acc.view() else { return Err(format!("accessor {i} has no bufferView")) };
+    let count = acc.count();
+    let elem = acc.size();
+    let stride = view.stride().unwrap_or(elem);
+    if count == 0 {
+        return Err(format!("accessor {i} has count 0"));
+    }
+    if stride < elem {
+        return Err(format!(
+            "bufferView {} has byteStride {stride}, less than an element ({elem} bytes)",
+            view.index()
+        ));
+    }
+    let end = stride.checked_mul(count - 1).and_then(|s| s.checked_add(acc.offset())).and_then(|s| s.checked_add(elem));
+    if end.is_none_or(|e| e > view.length()) {
+        return Err(format!("accessor {i} reads past the end of bufferView {}", view.index()));
+    }
+    let buffer_len = buffers.get(view.buffer().index()).map_or(0, |d| d.len());
+    if view.offset().checked_add(view.length()).is_none_or(|e| e > buffer_len) {
+        return Err(format!("bufferView {} reads past the end of buffer {}", view.index(), view.buffer().index()));
+    }
+    Ok(())
+}
+
+/// Scene under construction.
+struct Loader<'a> {
+    builder: SceneBuilder,
+    buffers: &'a [::gltf::buffer::Data],
+    /// Our material of each glTF material (last slot: the default material).
+    materials: Vec<Option<(MaterialId, Material)>>,
+    emissive: Vec<EmissiveTriangle>,
+    /// Primitive description and triangle number of each emissive triangle, for errors.
+    emissive_info: Vec<(String, usize)>,
+    camera: Option<Camera>,
+}
+
+impl Loader<'_> {
+    /// Adds the triangles of one primitive, transformed by `world`.
+    fn primitive(&mut self, mesh: &::gltf::Mesh, prim: &::gltf::Primitive, world: Mat4) -> Result<(), String> {
+        let mode = prim.mode();
+        if !matches!(mode, Mode::Triangles | Mode::TriangleStrip | Mode::TriangleFan) {
+            return Err(format!("mode {mode:?} is not a triangle mode (TRIANGLES, TRIANGLE_STRIP, TRIANGLE_FAN)"));
+        }
+        let pos_acc = prim.get(&Semantic::Positions).ok_or("no POSITION attribute")?;
+        check_accessor(&pos_acc, self.buffers, "Vec3 of F32", |t, d| t == DataType::F32 && d == Dimensions::Vec3)?;
+        let buffers = self.buffers;
+        let reader = prim.reader(|b| buffers.get(b.index()).map(|d| &d.0[..]));
+        let positions: Vec<Vec3> =
+            reader.read_positions().ok_or("cannot read POSITION")?.map(|p| world.transform_point3(p.into())).collect();
+        if let Some(i) = positions.iter().position(|p| !p.is_finite()) {
+            return Err(format!("vertex {i} has a non-finite coordinate {}", positions[i]));
+        }
+        let indices: Vec<u32> = match prim.indices() {
+            Some(acc) => {
+                let ok = |t, d| matches!(t, DataType::U8 | DataType::U16 | DataType::U32) && d == Dimensions::Scalar;
+                check_accessor(&acc, self.buffers, "Scalar of U8, U16 or U32", ok)?;
+                reader.read_indices().ok_or("cannot read indices")?.into_u32().collect()
+            }
+            None => (0..positions.len() as u32).collect(),
+        };
+        if let Some(&i) = indices.iter().find(|&&i| i as usize >= positions.len()) {
+            return Err(format!("index {i} out of range: {} vertices", positions.len()));
+        }
+        if mode == Mode::Triangles && indices.len() % 3 != 0 {
+            return Err(format!("{} indices (vertices) is not a multiple of 3 for TRIANGLES", indices.len()));
+        }
+        let flip = world.determinant() < 0.0;
+        let (m, mat) = self.material(prim.material());
+        for (k, t) in triangles(mode, &indices).enumerate() {
+            let [a, b, c] = t.map(|i| positions[i as usize]);
+            let (b, c) = if flip { (c, b) } else { (b, c) };
+            let id = self.builder.triangle(a, b, c, m);
+            if mat.is_emissive() {
+                self.emissive.push(EmissiveTriangle { id, vertices: [a, b, c], radiance: mat.emission });
+                self.emissive_info.push((describe(mesh, prim), k));
+            }
+        }
+        Ok(())
+    }
+
+    /// Our material for a glTF material, created on first use.
+    fn material(&mut self, m: ::gltf::Material) -> (MaterialId, Material) {
+        let slot = m.index().unwrap_or(self.materials.len() - 1);
+        if let Some(done) = &self.materials[slot] {
+            return done.clone();
+        }
+        let mat = match m.index() {
+            None => Material::diffuse("default", Vec3::splat(0.8)),
+            Some(i) => {
+                let base = m.pbr_metallic_roughness().base_color_factor();
+                let strength = m.emissive_strength().unwrap_or(1.0);
+                Material {
+                    name: m.name().map_or_else(|| format!("material {i}"), str::to_string),
+                    albedo: Vec3::new(base[0], base[1], base[2]).clamp(Vec3::ZERO, Vec3::ONE),
+                    emission: Vec3::from(m.emissive_factor()) * strength,
+                }
+            }
+        };
+        let id = self.builder.material(mat.clone());
+        self.materials[slot] = Some((id, mat.clone()));
+        (id, mat)
+    }
+
+    /// Takes the node's camera if it is perspective.
+    fn camera(&mut self, node: &::gltf::Node, world: Mat4) -> Result<(), String> {
+        let Some(cam) = node.camera() else { return Ok(()) };
+        let ::gltf::camera::Projection::Perspective(p) = cam.projection() else { return Ok(()) };
+        let eye = world.transform_point3(Vec3::ZERO);
+        let forward = world.transform_vector3(Vec3::NEG_Z).normalize_or_zero();
+        let up = world.transform_vector3(Vec3::Y);
+        let c = Camera::new(eye, eye + forward, up, p.yfov().to_degrees())
+            .map_err(|e| format!("camera {} of node {}: {e}", cam.index(), node.index()))?;
+        self.camera = Some(c);
+        Ok(())
+    }
+
+    /// Groups the lights and builds the scene.
+    fn finish(mut self, path: &Path) -> Result<Scene> {
+        if self.builder.triangle_count() == 0 {
+            return Err(parse_error(path, None, "no triangles: the default scene has no triangle meshes".into()));
+        }
+        if self.emissive.is_empty() {
+            let m = "no lights: no primitive has an emissive material (emissiveFactor > 0)".to_string();
+            return Err(parse_error(path, None, m));
+        }
+        lights::add_lights(&mut self.builder, &self.emissive).map_err(|z| {
+            let (prim, k) = &self.emissive_info[z.index];
+            parse_error(path, None, format!("{prim}: emissive triangle {k} has zero area: a light must have an area"))
+        })?;
+        if let Some(c) = self.camera {
+            self.builder.camera(c);
+        }
+        self.builder.build().map_err(|e| match e {
+            Error::InvalidScene(m) => parse_error(path, None, m),
+            e => e,
+        })
+    }
+}
+
+/// The triangles of a primitive's index list, counter-clockwise, for its mode (glTF 2.0 §3.7.2.1).
+fn triangles(mode: Mode, idx: &[u32]) -> Box<dyn Iterator<Item = [u32; 3]> + '_> {
+    let n = idx.len();
+    match mode {
+        Mode::TriangleStrip => Box::new((0..n.saturating_sub(2)).map(move |i| {
+            if i % 2 == 0 {
+                [idx[i], idx[i + 1], idx[i + 2]]
+            } else {
+                [idx[i], idx[i + 2], idx[i + 1]]
+            }
+        })),
+        Mode::TriangleFan => Box::new((1..n.saturating_sub(1)).map(move |i| [idx[i], idx[i + 1], idx[0]])),
+        _ => Box::new(idx.chunks_exact(3).map(|t| [t[0], t[1], t[2]])),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn strips_and_fans_keep_the_winding() {
+        let strip: Vec<_> = triangles(Mode::TriangleStrip, &[0, 1, 2, 3]).collect();
+        assert_eq!(strip, [[0, 1, 2], [1, 3, 2]]);
+        let fan: Vec<_> = triangles(Mode::TriangleFan, &[0, 1, 2, 3]).collect();
+        assert_eq!(fan, [[1, 2, 0], [2, 3, 0]]);
+        assert_eq!(triangles(Mode::Triangles, &[0, 1, 2, 3]).count(), 1);
+    }
+}

@@ -1,0 +1,343 @@
+//! Wavefront OBJ + MTL scenes (SPEC §1 scene model), read with `tobj` through a checking line filter
+//! ([`super::obj_lines`]).
+//!
+//! What is read: `v` (with an optional `w`, which divides; vertex colours are ignored), `f` (polygons
+//! are fan-triangulated; positive and negative indices; texture and normal indices are ignored), `o`/`g`,
+//! `mtllib` (paths relative to the OBJ; several names on one line are allowed), `usemtl`, and in the MTL
+//! files `newmtl`, `Kd` (diffuse albedo, clamped to [0, 1]) and `Ke` (emitted radiance). A repeated
+//! `Kd` in one material: the last one counts, as in other OBJ readers. Everything else (normals, texture
+//! coordinates, `Ka`, `Ks`, `d`, `Tr`, maps, lines, points) is ignored: surfaces are opaque and
+//! Lambertian. An emissive triangle emits on the side its counter-clockwise winding faces; vertex
+//! normals are not used. Emissive triangles are grouped into lights by [`super::lights`].
+//!
+//! Faces before any `usemtl` get a grey default material (albedo 0.8). Everything that would make a
+//! scene silently differ from its file is an error naming the file and line: a `mtllib` that cannot be
+//! read, a `usemtl` naming a material no library defines, a malformed number, an index out of range, a
+//! non-finite coordinate, a face with fewer than 3 vertices, an empty file, a file without lights.
+
+use std::cell::RefCell;
+use std::collections::{HashMap, HashSet};
+use std::fmt::Write as _;
+use std::fs::File;
+use std::io::BufReader;
+use std::path::{Path, PathBuf};
+use std::str::SplitWhitespace;
+
+use glam::Vec3;
+
+use super::lights::{self, EmissiveTriangle};
+use super::obj_lines::{parse_finite, rest_after_keyword, strip_comment, LineFilter, LineRules};
+use super::{parse_error, scene_name};
+use crate::error::{Error, Result};
+use crate::scene::{Material, MaterialId, Scene, SceneBuilder};
+
+/// Loads an OBJ file and the MTL files it names (see the module doc).
+pub fn load_obj(path: &Path) -> Result<Scene> {
+    let file = File::open(path).map_err(|source| Error::Io { path: path.to_path_buf(), source })?;
+    let libs = RefCell::new(Libraries::default());
+    let dir = path.parent().unwrap_or(Path::new(""));
+    let mut reader = LineFilter::new(BufReader::new(file), ObjRules::new(&libs));
+    let options = tobj::LoadOptions { triangulate: true, single_index: true, ignore_points: true, ignore_lines: true };
+    let result = tobj::load_obj_buf(&mut reader, &options, |lib| load_libraries(path, dir, lib, &libs));
+    if let Some(e) = libs.borrow_mut().error.take() {
+        return Err(e);
+    }
+    if let Some((line, message)) = reader.error() {
+        return Err(parse_error(path, Some(*line), message.clone()));
+    }
+    let (models, materials) = result.map_err(|e| parse_error(path, Some(reader.line()), e.to_string()))?;
+    let materials = materials.map_err(|e| parse_error(path, None, format!("material library: {e}")))?;
+    if reader.line() == 0 {
+        return Err(parse_error(path, None, "the file is empty".into()));
+    }
+    let has_mtllib = !libs.borrow().names.is_empty() || !libs.borrow().libs.is_empty();
+    build(path, &models, &materials, &reader.rules.tri_lines, has_mtllib)
+}
+
+/// State shared by the OBJ filter and the MTL loader.
+#[derive(Default)]
+struct Libraries {
+    /// Materials defined by the libraries loaded so far.
+    names: HashSet<String>,
+    /// `mtllib` names seen so far.
+    libs: Vec<String>,
+    /// Line of the `mtllib` being loaded.
+    line: usize,
+    /// The first error loading a library.
+    error: Option<Error>,
+}
+
+/// Checks OBJ lines (module doc) and keeps what the loader needs to name lines later.
+struct ObjRules<'a> {
+    libs: &'a RefCell<Libraries>,
+    vertices: usize,
+    /// The line of every triangle `tobj` will produce, in order.
+    tri_lines: Vec<u32>,
+}
+
+impl<'a> ObjRules<'a> {
+    fn new(libs: &'a RefCell<Libraries>) -> Self {
+        ObjRules { libs, vertices: 0, tri_lines: Vec::new() }
+    }
+
+    fn vertex(&mut self, words: SplitWhitespace, out: &mut String) -> Result<(), String> {
+        self.vertices += 1;
+        let n = self.vertices;
+        let tokens: Vec<&str> = words.take(8).collect();
+        let what = || format!("vertex {n}");
+        match tokens.len() {
+            3 | 6 => {
+                out.push('v');
+                for t in &tokens[..3] {
+                    parse_finite(t, &what())?;
+                    out.push(' ');
+                    out.push_str(t);
+                }
+            }
+            4 => {
+                let mut p = [0.0f32; 4];
+                for (x, t) in p.iter_mut().zip(&tokens) {
+                    *x = parse_finite(t, &what())?;
+                }
+                if p[3] == 0.0 {
+                    return Err(format!("vertex {n} has weight w = 0"));
+                }
+                let v = Vec3::new(p[0], p[1], p[2]) / p[3];
+                if !v.is_finite() {
+                    return Err(format!("vertex {n} is not finite after dividing by w = {}", p[3]));
+                }
+                let _ = write!(out, "v {} {} {}", v.x, v.y, v.z);
+            }
+            k => return Err(format!("vertex {n} has {k} numbers; expected x y z, x y z w or x y z r g b")),
+        }
+        Ok(())
+    }
+
+    fn face(&mut self, line: usize, words: SplitWhitespace, out: &mut String) -> Result<(), String> {
+        let v = self.vertices as u64;
+        out.push('f');
+        let mut k = 0usize;
+        for token in words {
+            let index = token.split('/').next().unwrap_or("");
+            let i: i64 = index.parse().map_err(|_| format!("malformed vertex index '{token}' in a face"))?;
+            let absolute = match i {
+                0 => return Err("vertex index 0 in a face (OBJ indices start at 1)".into()),
+                i if i > 0 && i as u64 <= v => i as u64,
+                i if i < 0 && i.unsigned_abs() <= v => v + 1 - i.unsigned_abs(),
+                i => return Err(format!("vertex index {i} out of range: {v} vertices are defined before this line")),
+            };
+            let _ = write!(out, " {absolute}");
+            k += 1;
+        }
+        if k < 3 {
+            return Err(format!("face with {k} vertices; a face needs at least 3"));
+        }
+        self.tri_lines.extend(std::iter::repeat_n(line as u32, k - 2));
+        Ok(())
+    }
+
+    fn usemtl(&mut self, name: &str, out: &mut String) -> Result<(), String> {
+        if name.is_empty() {
+            return Err("usemtl without a material name".into());
+        }
+        let libs = self.libs.borrow();
+        if !libs.names.contains(name) {
+            return Err(if libs.libs.is_empty() {
+                format!("usemtl '{name}', but no mtllib comes before it: the material is not defined")
+            } else {
+                format!("usemtl '{name}': no material of that name in {}", libs.libs.join(", "))
+            });
+        }
+        let _ = write!(out, "usemtl {name}");
+        Ok(())
+    }
+}
+
+impl LineRules for ObjRules<'_> {
+    fn rewrite(&mut self, line: usize, text: &str, out: &mut String) -> Result<(), String> {
+        if self.libs.borrow().error.is_some() {
+            return Err("reading stopped: a material library failed".into());
+        }
+        let text = strip_comment(text);
+        let mut words = text.split_whitespace();
+        let Some(keyword) = words.next() else { return Ok(()) };
+        match keyword {
+            "v" => self.vertex(words, out),
+            "f" => self.face(line, words, out),
+            "usemtl" => self.usemtl(rest_after_keyword(text, keyword), out),
+            "mtllib" => {
+                let name = rest_after_keyword(text, keyword);
+                if name.is_empty() {
+                    return Err("mtllib without a file name".into());
+                }
+                let mut libs = self.libs.borrow_mut();
+                libs.line = line;
+                libs.libs.push(name.to_string());
+                let _ = write!(out, "mtllib {name}");
+                Ok(())
+            }
+            "o" | "g" => {
+                let _ = write!(out, "{keyword} {}", rest_after_keyword(text, keyword));
+                Ok(())
+            }
+            _ => Ok(()),
+        }
+    }
+}
+
+/// Checks MTL lines: `newmtl` (recording the name), `Kd` and `Ke`; drops the rest.
+struct MtlRules<'a> {
+    libs: &'a RefCell<Libraries>,
+}
+
+impl LineRules for MtlRules<'_> {
+    fn rewrite(&mut self, _line: usize, text: &str, out: &mut String) -> Result<(), String> {
+        let text = strip_comment(text);
+        let mut words = text.split_whitespace();
+        let Some(keyword) = words.next() else { return Ok(()) };
+        match keyword {
+            "newmtl" => {
+                let name = rest_after_keyword(text, keyword);
+                if name.is_empty() {
+                    return Err("newmtl without a name".into());
+                }
+                self.libs.borrow_mut().names.insert(name.to_string());
+                let _ = write!(out, "newmtl {name}");
+            }
+            "Kd" | "Ke" => {
+                let tokens: Vec<&str> = words.take(4).collect();
+                let rgb = match tokens[..] {
+                    [x] => [x, x, x],
+                    [r, g, b] => [r, g, b],
+                    [first, ..] if first == "spectral" || first == "xyz" => {
+                        return Err(format!("{keyword} {first} is not supported; give r g b"))
+                    }
+                    _ => return Err(format!("{keyword} needs 3 numbers (r g b), found {}", tokens.len())),
+                };
+                for t in rgb {
+                    if parse_finite(t, keyword)? < 0.0 && keyword == "Ke" {
+                        return Err(format!("Ke has a negative value '{t}': emitted radiance cannot be negative"));
+                    }
+                }
+                let _ = write!(out, "{keyword} {} {} {}", rgb[0], rgb[1], rgb[2]);
+            }
+            _ => {}
+        }
+        Ok(())
+    }
+}
+
+/// The `tobj` material loader: loads the library (or libraries) named on one `mtllib` line. Errors are
+/// kept in `libs` (tobj would only keep a bare error kind and go on).
+fn load_libraries(obj: &Path, dir: &Path, lib: &Path, libs: &RefCell<Libraries>) -> tobj::MTLLoadResult {
+    let whole = dir.join(lib);
+    let name = lib.to_string_lossy();
+    let files: Vec<PathBuf> = if whole.is_file() || !name.contains(char::is_whitespace) {
+        vec![whole]
+    } else {
+        name.split_whitespace().map(|n| dir.join(n)).collect()
+    };
+    let (mut all, mut map): (Vec<tobj::Material>, _) = (Vec::new(), Default::default());
+    for file in files {
+        let (mut mats, names) = load_library(obj, &file, libs)?;
+        let offset = all.len();
+        all.append(&mut mats);
+        for (k, i) in names {
+            tobj_insert(&mut map, k, i + offset);
+        }
+    }
+    Ok((all, map))
+}
+
+/// Inserts into `tobj`'s material name map, whatever map type it uses.
+fn tobj_insert<M: Extend<(String, usize)>>(map: &mut M, name: String, index: usize) {
+    map.extend(std::iter::once((name, index)));
+}
+
+/// Loads one MTL file; an error is kept in `libs` and `tobj` gets only its kind.
+fn load_library(obj: &Path, file: &Path, libs: &RefCell<Libraries>) -> tobj::MTLLoadResult {
+    let fail = |e: Error| {
+        libs.borrow_mut().error.get_or_insert(e);
+        tobj::LoadError::OpenFileFailed
+    };
+    let line = libs.borrow().line;
+    let f = File::open(file).map_err(|e| {
+        fail(parse_error(obj, Some(line), format!("mtllib: cannot open material library {}: {e}", file.display())))
+    })?;
+    let mut reader = LineFilter::new(BufReader::new(f), MtlRules { libs });
+    let result = tobj::load_mtl_buf(&mut reader);
+    if let Some((l, message)) = reader.error() {
+        let e = parse_error(file, Some(*l), message.clone());
+        return Err(fail(e));
+    }
+    result.map_err(|e| fail(parse_error(file, Some(reader.line()), e.to_string())))
+}
+
+/// Our material for a `tobj` material index (`None`: faces before any `usemtl`).
+fn material(materials: &[tobj::Material], id: Option<usize>) -> Material {
+    match id.and_then(|i| materials.get(i)) {
+        None => Material::diffuse("default", Vec3::splat(0.8)),
+        Some(m) => Material {
+            name: m.name.clone(),
+            albedo: m.diffuse.map_or(Vec3::splat(0.8), Vec3::from).clamp(Vec3::ZERO, Vec3::ONE),
+            emission: m.emissive.map_or(Vec3::ZERO, Vec3::from),
+        },
+    }
+}
+
+/// Builds the scene from `tobj`'s meshes; `tri_lines` is the OBJ line of every triangle, in order.
+fn build(
+    path: &Path,
+    models: &[tobj::Model],
+    materials: &[tobj::Material],
+    tri_lines: &[u32],
+    has_mtllib: bool,
+) -> Result<Scene> {
+    let mut b = SceneBuilder::new(&scene_name(path));
+    let mut ids: HashMap<Option<usize>, (MaterialId, Material)> = HashMap::new();
+    let mut emissive = Vec::new();
+    let mut emissive_info = Vec::new();
+    let mut t = 0usize;
+    for model in models {
+        let mesh = &model.mesh;
+        let (m, mat) = ids
+            .entry(mesh.material_id)
+            .or_insert_with(|| {
+                let mat = material(materials, mesh.material_id);
+                (b.material(mat.clone()), mat)
+            })
+            .clone();
+        let vertex = |i: u32| {
+            let i = i as usize * 3;
+            mesh.positions.get(i..i + 3).map(|p| Vec3::new(p[0], p[1], p[2]))
+        };
+        for tri in mesh.indices.chunks_exact(3) {
+            let line = tri_lines.get(t).map(|&l| l as usize);
+            t += 1;
+            let (Some(a), Some(bb), Some(c)) = (vertex(tri[0]), vertex(tri[1]), vertex(tri[2])) else {
+                return Err(parse_error(path, line, "face vertex index out of range".into()));
+            };
+            let id = b.triangle(a, bb, c, m);
+            if mat.is_emissive() {
+                emissive.push(EmissiveTriangle { id, vertices: [a, bb, c], radiance: mat.emission });
+                emissive_info.push((line, mat.name.clone()));
+            }
+        }
+    }
+    if b.triangle_count() == 0 {
+        return Err(parse_error(path, None, "no faces: the file defines no triangles".into()));
+    }
+    if emissive.is_empty() {
+        let hint = if has_mtllib { "" } else { "; the file has no mtllib" };
+        let message = format!("no lights: no face has an emissive material (Ke > 0 in an MTL file){hint}");
+        return Err(parse_error(path, None, message));
+    }
+    lights::add_lights(&mut b, &emissive).map_err(|z| {
+        let (line, name) = &emissive_info[z.index];
+        parse_error(path, *line, format!("emissive face (material '{name}') has zero area: a light must have an area"))
+    })?;
+    b.build().map_err(|e| match e {
+        Error::InvalidScene(m) => parse_error(path, None, m),
+        e => e,
+    })
+}

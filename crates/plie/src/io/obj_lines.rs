@@ -1,0 +1,183 @@
+//! A line filter between an OBJ/MTL file and `tobj` (SPEC §1 scene input): it counts lines, so every
+//! error names one, and passes on only the lines plie uses, each checked and normalised first.
+//!
+//! `tobj` reports errors without line numbers, finds out-of-range indices only at the end of a group,
+//! accepts `nan` as a coordinate, and panics on some malformed lines (`Ka 0.5`). The filter checks each
+//! line with [`LineRules`] before `tobj` sees it; a line it rejects stops the read with an I/O error, and
+//! the loader reports the filter's message and line instead of `tobj`'s. Lines plie does not need
+//! (normals, texture coordinates, other material parameters) become blank lines, so `tobj` never
+//! parses them and line numbers stay the same.
+
+use std::io::{self, BufRead, Read};
+
+/// Checks and rewrites one line of a file for `tobj`.
+pub(super) trait LineRules {
+    /// Writes the line (1-based number `line`, no line ending) as `tobj` should see it into `out` (empty
+    /// to drop it), or returns what is wrong with it.
+    fn rewrite(&mut self, line: usize, text: &str, out: &mut String) -> Result<(), String>;
+}
+
+/// A [`BufRead`] that reads `inner` line by line through [`LineRules`].
+pub(super) struct LineFilter<R, L> {
+    inner: R,
+    /// The rules (public to the loader after reading).
+    pub rules: L,
+    raw: Vec<u8>,
+    out: String,
+    pos: usize,
+    line: usize,
+    error: Option<(usize, String)>,
+}
+
+impl<R: BufRead, L: LineRules> LineFilter<R, L> {
+    /// A filter over `inner`.
+    pub fn new(inner: R, rules: L) -> Self {
+        LineFilter { inner, rules, raw: Vec::new(), out: String::new(), pos: 0, line: 0, error: None }
+    }
+
+    /// Number of lines read so far (the line being parsed, while `tobj` works on it).
+    pub fn line(&self) -> usize {
+        self.line
+    }
+
+    /// The first line the filter rejected and why.
+    pub fn error(&self) -> Option<&(usize, String)> {
+        self.error.as_ref()
+    }
+
+    fn fail(&mut self, message: String) -> io::Error {
+        let e = io::Error::new(io::ErrorKind::InvalidData, message.clone());
+        self.error.get_or_insert((self.line, message));
+        e
+    }
+
+    /// Reads, checks and rewrites the next line into `out`; at the end of the file `out` stays empty.
+    fn next_line(&mut self) -> io::Result<()> {
+        self.out.clear();
+        self.pos = 0;
+        if self.error.is_some() {
+            return Err(io::Error::new(io::ErrorKind::InvalidData, "reading stopped after an error"));
+        }
+        self.raw.clear();
+        let n = match self.inner.read_until(b'\n', &mut self.raw) {
+            Ok(n) => n,
+            Err(e) => {
+                self.line += 1;
+                return Err(self.fail(format!("read error: {e}")));
+            }
+        };
+        if n == 0 {
+            return Ok(());
+        }
+        self.line += 1;
+        let complete = self.raw.last() == Some(&b'\n');
+        let mut end = self.raw.len() - usize::from(complete);
+        if end > 0 && self.raw[end - 1] == b'\r' {
+            end -= 1;
+        }
+        let raw = std::mem::take(&mut self.raw);
+        let result = match std::str::from_utf8(&raw[..end]) {
+            Ok(text) => self.rules.rewrite(self.line, text, &mut self.out),
+            Err(_) => Err("the line is not valid UTF-8 text".to_string()),
+        };
+        self.raw = raw;
+        if let Err(mut message) = result {
+            if !complete {
+                message.push_str(" (the file ends in the middle of this line: is it truncated?)");
+            }
+            return Err(self.fail(message));
+        }
+        self.out.push('\n');
+        Ok(())
+    }
+}
+
+impl<R: BufRead, L: LineRules> Read for LineFilter<R, L> {
+    fn read(&mut self, buf: &mut [u8]) -> io::Result<usize> {
+        let avail = self.fill_buf()?;
+        let n = avail.len().min(buf.len());
+        buf[..n].copy_from_slice(&avail[..n]);
+        self.consume(n);
+        Ok(n)
+    }
+}
+
+impl<R: BufRead, L: LineRules> BufRead for LineFilter<R, L> {
+    fn fill_buf(&mut self) -> io::Result<&[u8]> {
+        if self.pos >= self.out.len() {
+            self.next_line()?;
+        }
+        Ok(&self.out.as_bytes()[self.pos..])
+    }
+
+    fn consume(&mut self, amt: usize) {
+        self.pos = (self.pos + amt).min(self.out.len());
+    }
+}
+
+/// The line without its comment: everything from a `#` that starts a word.
+pub(super) fn strip_comment(line: &str) -> &str {
+    let mut prev_space = true;
+    for (i, ch) in line.char_indices() {
+        if ch == '#' && prev_space {
+            return &line[..i];
+        }
+        prev_space = ch.is_whitespace();
+    }
+    line
+}
+
+/// The text after the first word (`usemtl`, `mtllib`, `newmtl`, `g`), trimmed.
+pub(super) fn rest_after_keyword<'a>(line: &'a str, keyword: &str) -> &'a str {
+    line.trim_start().get(keyword.len()..).unwrap_or("").trim()
+}
+
+/// Parses a finite `f32`, naming `what` in the error.
+pub(super) fn parse_finite(token: &str, what: &str) -> Result<f32, String> {
+    match token.parse::<f32>() {
+        Ok(x) if x.is_finite() => Ok(x),
+        Ok(_) => Err(format!("{what} has a non-finite value '{token}'")),
+        Err(_) => Err(format!("malformed number '{token}' in {what}")),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    struct Upper;
+    impl LineRules for Upper {
+        fn rewrite(&mut self, _: usize, text: &str, out: &mut String) -> Result<(), String> {
+            if text == "bad" {
+                return Err("bad line".into());
+            }
+            out.push_str(&text.to_uppercase());
+            Ok(())
+        }
+    }
+
+    #[test]
+    fn rewrites_lines_and_counts_them() {
+        let mut f = LineFilter::new(&b"a\r\nb\n\nc"[..], Upper);
+        let lines: Vec<String> = (&mut f).lines().map(|l| l.unwrap()).collect();
+        assert_eq!(lines, ["A", "B", "", "C"]);
+        assert_eq!(f.line(), 4);
+    }
+
+    #[test]
+    fn stops_at_a_bad_line_and_notes_truncation() {
+        let mut f = LineFilter::new(&b"a\nbad"[..], Upper);
+        let lines: Vec<_> = (&mut f).lines().collect();
+        assert!(lines[1].is_err());
+        let (line, msg) = f.error().unwrap();
+        assert_eq!(*line, 2);
+        assert!(msg.contains("truncated"), "{msg}");
+    }
+
+    #[test]
+    fn comments() {
+        assert_eq!(strip_comment("Ka 1 2 3 # red"), "Ka 1 2 3 ");
+        assert_eq!(strip_comment("newmtl a#b"), "newmtl a#b");
+        assert_eq!(strip_comment("# all"), "");
+    }
+}

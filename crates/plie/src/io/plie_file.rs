@@ -1,0 +1,193 @@
+//! The `.plie` file: a P-LIE saved once and loaded for any number of renders.
+//!
+//! Layout (little-endian):
+//!
+//! | bytes | content |
+//! |---|---|
+//! | 8 | magic `PLIE\r\n\x1a\n` |
+//! | 4 | format version ([`FORMAT_VERSION`]) |
+//! | 8 | payload length |
+//! | 8 | XXH3-64 checksum of the payload |
+//! | n | payload: [`FileBody`] in postcard encoding |
+//!
+//! The payload holds the build parameters, a fingerprint of the scene's geometry, materials and lights,
+//! a fingerprint of the octree the P-LIE was built on, and the P-LIE. The octree itself is not stored:
+//! it is a deterministic function of the scene and the parameters, and is rebuilt on load (a fraction
+//! of the P-LIE's build time); its fingerprint proves it is the same one. Every way a file can be wrong
+//! (another format, another version, truncated, corrupted, another scene, other parameters, an
+//! inconsistent structure) is an error, never a panic. Writes are atomic.
+
+use std::io::Write;
+use std::path::Path;
+
+use serde::{Deserialize, Serialize};
+use xxhash_rust::xxh3::{xxh3_64, Xxh3};
+
+use super::atomic::write_atomic;
+use crate::error::{Error, Result};
+use crate::lie::{Plie, PlieParams, NO_RECORD};
+use crate::octree::Octree;
+use crate::scene::Scene;
+
+/// First bytes of every `.plie` file.
+pub const MAGIC: [u8; 8] = *b"PLIE\r\n\x1a\n";
+/// Version of the layout written by this build of plie.
+pub const FORMAT_VERSION: u32 = 1;
+const HEADER: usize = 8 + 4 + 8 + 8;
+
+/// What a `.plie` file holds after its header.
+#[derive(Serialize, Deserialize)]
+pub struct FileBody {
+    /// Build parameters.
+    pub params: PlieParams,
+    /// [`scene_fingerprint`] of the scene it was built for.
+    pub scene_fingerprint: u64,
+    /// [`octree_fingerprint`] of the octree it was built on.
+    pub octree_fingerprint: u64,
+    /// The P-LIE.
+    pub plie: Plie,
+}
+
+/// A hash of everything that shapes the P-LIE: triangles, their materials' emission, lights.
+pub fn scene_fingerprint(scene: &Scene) -> u64 {
+    let mut h = Xxh3::new();
+    h.update(&(scene.triangles.len() as u64).to_le_bytes());
+    for t in &scene.triangles {
+        for v in &t.v {
+            for c in v.to_array() {
+                h.update(&c.to_le_bytes());
+            }
+        }
+    }
+    for l in &scene.tri_light {
+        h.update(&l.map_or(u32::MAX, |l| l.0).to_le_bytes());
+    }
+    for l in &scene.lights {
+        for v in &l.vertices {
+            for c in v.to_array() {
+                h.update(&c.to_le_bytes());
+            }
+        }
+        for c in l.radiance.to_array() {
+            h.update(&c.to_le_bytes());
+        }
+    }
+    h.digest()
+}
+
+/// A hash of the octree's leaves: their boxes and triangle lists.
+pub fn octree_fingerprint(octree: &Octree) -> u64 {
+    let mut h = Xxh3::new();
+    for l in octree.leaves() {
+        let b = octree.leaf_bounds(l);
+        for c in b.min.to_array().into_iter().chain(b.max.to_array()) {
+            h.update(&c.to_le_bytes());
+        }
+        h.update(&(octree.leaf_triangles(l).len() as u32).to_le_bytes());
+        for t in octree.leaf_triangles(l) {
+            h.update(&t.0.to_le_bytes());
+        }
+    }
+    h.digest()
+}
+
+/// Saves the P-LIE built for `scene` on `octree`, atomically. Returns the bytes written.
+pub fn save_plie(path: &Path, scene: &Scene, octree: &Octree, plie: &Plie) -> Result<u64> {
+    let body = FileBody {
+        params: plie.params,
+        scene_fingerprint: scene_fingerprint(scene),
+        octree_fingerprint: octree_fingerprint(octree),
+        plie: plie.clone(),
+    };
+    let payload = postcard::to_stdvec(&body)
+        .map_err(|e| Error::Io { path: path.to_path_buf(), source: std::io::Error::other(e.to_string()) })?;
+    let io = |source| Error::Io { path: path.to_path_buf(), source };
+    write_atomic(path, |w| {
+        w.write_all(&MAGIC).map_err(io)?;
+        w.write_all(&FORMAT_VERSION.to_le_bytes()).map_err(io)?;
+        w.write_all(&(payload.len() as u64).to_le_bytes()).map_err(io)?;
+        w.write_all(&xxh3_64(&payload).to_le_bytes()).map_err(io)?;
+        w.write_all(&payload).map_err(io)?;
+        Ok(())
+    })?;
+    Ok((HEADER + payload.len()) as u64)
+}
+
+/// Loads a `.plie` file for `scene`: checks format, version, integrity, that it was built for this
+/// scene (and, if `expect` is given, with these parameters), rebuilds the octree and checks that it is
+/// the one the P-LIE was built on. Returns the octree and the P-LIE.
+pub fn load_plie(path: &Path, scene: &Scene, expect: Option<PlieParams>) -> Result<(Octree, Plie)> {
+    let bytes = std::fs::read(path).map_err(|source| Error::Io { path: path.to_path_buf(), source })?;
+    let bad = |m: String| Error::Parse { path: path.to_path_buf(), line: None, message: m };
+    if bytes.len() < 8 || bytes[..8] != MAGIC {
+        return Err(bad("not a .plie file (wrong magic bytes)".into()));
+    }
+    if bytes.len() < HEADER {
+        return Err(bad("truncated .plie file (incomplete header)".into()));
+    }
+    let version = u32::from_le_bytes(bytes[8..12].try_into().expect("4 bytes"));
+    if version != FORMAT_VERSION {
+        return Err(bad(format!(
+            "made with .plie format version {version}; this plie reads version {FORMAT_VERSION}: rebuild it with `plie build`"
+        )));
+    }
+    let len = u64::from_le_bytes(bytes[12..20].try_into().expect("8 bytes"));
+    let sum = u64::from_le_bytes(bytes[20..28].try_into().expect("8 bytes"));
+    let payload = &bytes[HEADER..];
+    if (payload.len() as u64) < len {
+        return Err(bad(format!("truncated .plie file ({} of {len} payload bytes)", payload.len())));
+    }
+    if payload.len() as u64 != len {
+        return Err(bad(format!("corrupted .plie file ({} bytes after the payload)", payload.len() as u64 - len)));
+    }
+    if xxh3_64(payload) != sum {
+        return Err(bad("corrupted .plie file (checksum mismatch)".into()));
+    }
+    let body: FileBody =
+        postcard::from_bytes(payload).map_err(|e| bad(format!("corrupted .plie file (cannot decode: {e})")))?;
+    if body.scene_fingerprint != scene_fingerprint(scene) {
+        return Err(bad(format!("was built for another scene, not '{}' (rebuild it with `plie build`)", scene.name)));
+    }
+    if let Some(p) = expect {
+        if p != body.params {
+            return Err(bad(format!("was built with other parameters ({:?}) than asked for ({p:?})", body.params)));
+        }
+    }
+    body.params.octree().validate().map_err(|e| bad(format!("invalid parameters in file: {e}")))?;
+    let octree = Octree::build(scene, body.params.octree());
+    if octree_fingerprint(&octree) != body.octree_fingerprint {
+        return Err(bad("its octree differs from the one this plie builds for the scene: rebuild it".into()));
+    }
+    check_structure(&body.plie, scene, &octree).map_err(|m| bad(format!("inconsistent .plie file: {m}")))?;
+    Ok((octree, body.plie))
+}
+
+/// Every index in range, every record where the index says it is.
+fn check_structure(p: &Plie, scene: &Scene, octree: &Octree) -> std::result::Result<(), String> {
+    if p.leaves as usize != octree.leaf_count() || p.lights as usize != scene.lights.len() {
+        return Err(format!("{} leaves and {} lights, expected {} and {}", p.leaves, p.lights, octree.leaf_count(), scene.lights.len()));
+    }
+    if p.record_index.len() != p.leaves as usize * 6 * p.lights as usize {
+        return Err("record table has the wrong size".into());
+    }
+    for (i, &r) in p.record_index.iter().enumerate() {
+        if r == NO_RECORD {
+            continue;
+        }
+        let rec = p.records.get(r as usize).ok_or_else(|| format!("record index {r} out of range"))?;
+        let at = (rec.leaf.idx() * 6 + rec.face.index()) * p.lights as usize + rec.light.idx();
+        if at != i {
+            return Err(format!("record {r} is filed under the wrong (leaf, face, light)"));
+        }
+    }
+    for (i, rec) in p.records.iter().enumerate() {
+        let end = rec.blockers_start as u64 + rec.blockers_len as u64;
+        if end > p.blockers.len() as u64 {
+            return Err(format!("record {i}: blocker range out of bounds"));
+        }
+    }
+    if let Some(t) = p.blockers.iter().find(|t| t.idx() >= scene.triangles.len()) {
+        return Err(format!("blocker triangle {} out of range", t.0));
+    }
+    Ok(())
+}
