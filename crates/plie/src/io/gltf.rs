@@ -7,7 +7,8 @@
 //! albedo (textures ignored), `emissiveFactor` x `KHR_materials_emissive_strength` as emitted radiance;
 //! primitives without material get a grey default (albedo 0.8). The first perspective camera met in a
 //! depth-first walk of the scene becomes the scene camera (position, `-z` as view direction and `+y` as
-//! up from its node transform, `yfov` in degrees).
+//! up from its node transform, `yfov` in degrees). Skins and morph targets are ignored: meshes are
+//! taken in their rest pose.
 //!
 //! Errors name the file and what is wrong (JSON syntax errors also the line). The `gltf` crate trusts
 //! accessor types and ranges (it panics or asserts on bad ones), so every accessor is checked first:

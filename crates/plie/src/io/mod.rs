@@ -15,6 +15,7 @@ pub mod image;
 pub mod lights;
 pub mod obj;
 mod obj_lines;
+pub mod plie_file;
 
 use std::path::Path;
 
@@ -44,6 +45,23 @@ pub fn load_scene(path: &Path) -> Result<Scene> {
             ),
         )),
     }
+}
+
+/// Checks, before long work, that an image can be written to `path`: a supported extension and an
+/// existing directory.
+pub fn check_image_path(path: &Path) -> Result<()> {
+    ImageFormat::from_path(path)?;
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    };
+    if !dir.is_dir() {
+        return Err(Error::Io {
+            path: path.to_path_buf(),
+            source: std::io::Error::new(std::io::ErrorKind::NotFound, "the directory does not exist"),
+        });
+    }
+    Ok(())
 }
 
 /// An [`Error::Parse`] for `path`.

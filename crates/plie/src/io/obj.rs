@@ -1,5 +1,5 @@
 //! Wavefront OBJ + MTL scenes (SPEC §1 scene model), read with `tobj` through a checking line filter
-//! ([`super::obj_lines`]).
+//! (`obj_lines.rs`).
 //!
 //! What is read: `v` (with an optional `w`, which divides; vertex colours are ignored), `f` (polygons
 //! are fan-triangulated; positive and negative indices; texture and normal indices are ignored), `o`/`g`,
@@ -89,7 +89,7 @@ impl<'a> ObjRules<'a> {
             3 | 6 => {
                 out.push('v');
                 for t in &tokens[..3] {
-                    parse_finite(t, &what())?;
+                    parse_finite(t, what)?;
                     out.push(' ');
                     out.push_str(t);
                 }
@@ -97,7 +97,7 @@ impl<'a> ObjRules<'a> {
             4 => {
                 let mut p = [0.0f32; 4];
                 for (x, t) in p.iter_mut().zip(&tokens) {
-                    *x = parse_finite(t, &what())?;
+                    *x = parse_finite(t, what)?;
                 }
                 if p[3] == 0.0 {
                     return Err(format!("vertex {n} has weight w = 0"));
@@ -215,7 +215,7 @@ impl LineRules for MtlRules<'_> {
                     _ => return Err(format!("{keyword} needs 3 numbers (r g b), found {}", tokens.len())),
                 };
                 for t in rgb {
-                    if parse_finite(t, keyword)? < 0.0 && keyword == "Ke" {
+                    if parse_finite(t, || keyword)? < 0.0 && keyword == "Ke" {
                         return Err(format!("Ke has a negative value '{t}': emitted radiance cannot be negative"));
                     }
                 }

@@ -56,7 +56,8 @@ impl<R: BufRead, L: LineRules> LineFilter<R, L> {
         self.out.clear();
         self.pos = 0;
         if self.error.is_some() {
-            return Err(io::Error::new(io::ErrorKind::InvalidData, "reading stopped after an error"));
+            // The error was reported once; after it the file ends, so no reader can loop on errors.
+            return Ok(());
         }
         self.raw.clear();
         let n = match self.inner.read_until(b'\n', &mut self.raw) {
@@ -132,12 +133,13 @@ pub(super) fn rest_after_keyword<'a>(line: &'a str, keyword: &str) -> &'a str {
     line.trim_start().get(keyword.len()..).unwrap_or("").trim()
 }
 
-/// Parses a finite `f32`, naming `what` in the error.
-pub(super) fn parse_finite(token: &str, what: &str) -> Result<f32, String> {
+/// Parses a finite `f32`; `what` names the value's owner in the error (a closure, so the name is only
+/// formatted on error).
+pub(super) fn parse_finite<S: std::fmt::Display>(token: &str, what: impl Fn() -> S) -> Result<f32, String> {
     match token.parse::<f32>() {
         Ok(x) if x.is_finite() => Ok(x),
-        Ok(_) => Err(format!("{what} has a non-finite value '{token}'")),
-        Err(_) => Err(format!("malformed number '{token}' in {what}")),
+        Ok(_) => Err(format!("{} has a non-finite value '{token}'", what())),
+        Err(_) => Err(format!("malformed number '{token}' in {}", what())),
     }
 }
 
@@ -168,6 +170,7 @@ mod tests {
     fn stops_at_a_bad_line_and_notes_truncation() {
         let mut f = LineFilter::new(&b"a\nbad"[..], Upper);
         let lines: Vec<_> = (&mut f).lines().collect();
+        assert_eq!(lines.len(), 2, "the file ends after the error");
         assert!(lines[1].is_err());
         let (line, msg) = f.error().unwrap();
         assert_eq!(*line, 2);

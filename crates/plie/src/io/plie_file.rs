@@ -17,7 +17,6 @@
 //! (another format, another version, truncated, corrupted, another scene, other parameters, an
 //! inconsistent structure) is an error, never a panic. Writes are atomic.
 
-use std::io::Write;
 use std::path::Path;
 
 use serde::{Deserialize, Serialize};

@@ -178,6 +178,25 @@ fn without_strength_or_camera() {
 }
 
 #[test]
+fn camera_orientation_and_parent_transforms() {
+    // The camera hangs under a parent turned 90 degrees about +y and moved: it looks along -x.
+    let h = std::f32::consts::FRAC_1_SQRT_2;
+    let mut doc = embedded();
+    let parent = json!({"rotation": [0.0, h, 0.0, h], "translation": [10.0, 0.0, 0.0], "children": [2]});
+    doc["nodes"].as_array_mut().unwrap().push(parent);
+    doc["scenes"][0]["nodes"] = json!([0, 1, 3]);
+    let c = load_json(&doc).unwrap().camera.unwrap();
+    assert!((c.eye - Vec3::new(15.0, 1.0, 0.0)).length() < 1e-5, "{}", c.eye);
+    assert!((c.target - c.eye - Vec3::NEG_X).length() < 1e-5, "{}", c.target - c.eye);
+    assert!((c.up - Vec3::Y).length() < 1e-5);
+    // A full matrix works like TRS: the light moved up by a column-major translation.
+    let mut doc = embedded();
+    doc["nodes"][1] = json!({"mesh": 1, "matrix": [1,0,0,0, 0,1,0,0, 0,0,1,0, 0,3,0,1]});
+    let s = load_json(&doc).unwrap();
+    assert!(s.lights[0].vertices.iter().all(|v| v.y == 3.0));
+}
+
+#[test]
 fn malformed_json() {
     let text = "{\n  \"asset\": {\"version\": \"2.0\"},\n  \"nodes\": [ {\"mesh\": 0,,} ]\n}";
     let msg = parse_error(load_from(&[("s.gltf", text.as_bytes())], "s.gltf"), "s.gltf", Some(3));

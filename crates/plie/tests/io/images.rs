@@ -123,6 +123,18 @@ fn missing_directory_is_an_io_error_and_creates_nothing() {
 }
 
 #[test]
+fn parent_that_is_a_file_is_an_io_error() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("plain"), b"x").unwrap();
+    let path = dir.path().join("plain/a.pfm");
+    match save_image(&path, 1, 1, &[Vec3::ONE]) {
+        Err(Error::Io { path: p, .. }) => assert_eq!(p, path),
+        r => panic!("expected an I/O error, got {r:?}"),
+    }
+    assert_eq!(std::fs::read(dir.path().join("plain")).unwrap(), b"x");
+}
+
+#[test]
 fn failed_write_leaves_the_target_unchanged() {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("out.pfm");
