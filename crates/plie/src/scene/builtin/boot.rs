@@ -56,7 +56,7 @@ pub(super) fn boot() -> Result<SceneBuilder> {
     let n = (Vec3::new(0.0, 1.0, 0.0) - center).normalize();
     let u = any_perpendicular(n) * 1.5;
     b.light("sun", &rect(center, u, n.cross(u)), RADIANCE);
-    b.camera(Camera::new(Vec3::new(12.5, 4.5, -14.0), Vec3::new(0.0, 5.0, 0.0), Vec3::Y, 45.0)?);
+    b.camera(Camera::new(Vec3::new(12.5, 4.5, -14.0), Vec3::new(0.0, 5.6, 0.0), Vec3::Y, 48.0)?);
     Ok(b)
 }
 

@@ -25,7 +25,7 @@ use crate::scene::{Camera, MaterialId, SceneBuilder};
 /// The room's far corner.
 const ROOM: Vec3 = Vec3::new(5.0, 2.7, 4.2);
 /// Radiance of the ceiling lights (a warm white).
-const RADIANCE: Vec3 = Vec3::new(30.0, 28.0, 24.0);
+const RADIANCE: Vec3 = Vec3::new(48.0, 45.0, 40.0);
 /// Height of the desk top.
 const DESK_TOP: f32 = 0.75;
 
@@ -91,6 +91,7 @@ struct Mats {
     white: MaterialId,
     leaf: MaterialId,
     soil: MaterialId,
+    sea: MaterialId,
 }
 
 /// Which Huis.
@@ -156,6 +157,7 @@ fn materials(b: &mut SceneBuilder, pal: &Palette) -> Mats {
         white: b.diffuse("paper", Vec3::splat(0.85)),
         leaf: b.diffuse("leaf", Vec3::new(0.12, 0.38, 0.08)),
         soil: b.diffuse("soil", Vec3::new(0.2, 0.13, 0.08)),
+        sea: b.diffuse("globe", Vec3::new(0.12, 0.3, 0.6)),
     }
 }
 
@@ -202,7 +204,7 @@ fn furnishings(b: &mut SceneBuilder, m: &Mats, variant: Variant) {
     let table = Place::new(v(1.7, 0.0, 2.05), 0.0);
     round_table(b, &table, m.desk_wood, m.metal, 32);
     let globe_segments = if variant == Variant::A { 16 } else { 20 };
-    decor::globe(b, &table.then(v(0.05, 0.73, 0.0), 30.0), m.covers[1], m.metal, globe_segments);
+    decor::globe(b, &table.then(v(0.05, 0.73, 0.0), 30.0), m.sea, m.metal, globe_segments);
     decor::plant(b, &Place::new(v(0.45, 0.0, 3.2), 0.0), m.accent, m.soil, m.leaf, 18);
     // Fittings on the walls: local z = 0 on the wall, local z pointing into the room.
     let left_wall = |z: f32| Place::new(v(0.0, 0.0, z), 90.0);
