@@ -11,8 +11,9 @@
 
 use glam::Vec3;
 
-use super::shapes::{any_perpendicular, rect, Cap, Facing, Node, Side};
+use super::shapes::{any_perpendicular, rect, Cap, Facing, Node};
 use crate::error::Result;
+use crate::octree::Dir;
 use crate::scene::{Camera, MaterialId, SceneBuilder};
 
 /// Radiance of the distant light.
@@ -140,7 +141,7 @@ fn superstructure(b: &mut SceneBuilder, cabin: MaterialId, dark: MaterialId, tea
             b.axis_box(
                 Vec3::new(x - 0.3, base + 0.2, z0),
                 Vec3::new(x + 0.3, base + 0.33, z1),
-                &Side::ALL,
+                &Dir::ALL,
                 Facing::Outward,
                 dark,
             );
@@ -150,7 +151,7 @@ fn superstructure(b: &mut SceneBuilder, cabin: MaterialId, dark: MaterialId, tea
     b.axis_box(
         Vec3::new(hx - 0.3, sheer(hx), -0.3),
         Vec3::new(hx + 0.3, sheer(hx) + 0.2, 0.3),
-        &Side::ALL,
+        &Dir::ALL,
         Facing::Outward,
         teak,
     );
@@ -158,7 +159,7 @@ fn superstructure(b: &mut SceneBuilder, cabin: MaterialId, dark: MaterialId, tea
         b.axis_box(
             Vec3::new(x0, sheer(x1) - 0.05, z0),
             Vec3::new(x1, sheer(x1) + 0.25, z1),
-            &Side::ALL,
+            &Dir::ALL,
             Facing::Outward,
             teak,
         );

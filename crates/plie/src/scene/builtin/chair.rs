@@ -6,7 +6,8 @@
 
 use glam::Vec3;
 
-use super::shapes::{Cap, Facing, Node, Place, Side};
+use super::shapes::{Cap, Facing, Node, Place};
+use crate::octree::Dir;
 use crate::scene::{MaterialId, SceneBuilder};
 
 /// Materials of the chair.
@@ -66,7 +67,7 @@ fn star_base(b: &mut SceneBuilder, at: &Place, paint: ChairPaint, detail: ChairD
             let z = if i & 4 != 0 { half_w } else { -half_w };
             leg.p(v(x, y, z))
         };
-        b.hexahedron(&std::array::from_fn(corner), &Side::ALL, Facing::Outward, paint.frame);
+        b.hexahedron(&std::array::from_fn(corner), &Dir::ALL, Facing::Outward, paint.frame);
         // Caster: a fork under the leg tip and two wheels on a horizontal axle across the leg.
         b.local_box(&leg, v(LEG_REACH - 0.035, 0.05, -0.018), v(LEG_REACH + 0.005, 0.075, 0.018), paint.plastic);
         for side in [-1.0, 1.0] {

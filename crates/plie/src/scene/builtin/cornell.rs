@@ -21,8 +21,9 @@
 
 use glam::Vec3;
 
-use super::shapes::{rect, Facing, Side};
+use super::shapes::{rect, Facing};
 use crate::error::Result;
+use crate::octree::Dir;
 use crate::scene::{Camera, MaterialId, SceneBuilder};
 
 /// The room's far corner: x, y, z extents in millimetres.
@@ -56,8 +57,7 @@ pub(super) fn room(name: &str) -> Result<(SceneBuilder, MaterialId)> {
     let white = b.diffuse("white", Vec3::splat(0.73));
     let red = b.diffuse("red", Vec3::new(0.63, 0.065, 0.05));
     let green = b.diffuse("green", Vec3::new(0.14, 0.45, 0.09));
-    for (side, m) in
-        [(Side::Down, white), (Side::Up, white), (Side::Front, white), (Side::Left, green), (Side::Right, red)]
+    for (side, m) in [(Dir::Down, white), (Dir::Up, white), (Dir::Front, white), (Dir::Left, green), (Dir::Right, red)]
     {
         b.axis_box(Vec3::ZERO, ROOM, &[side], Facing::Inward, m);
     }

@@ -18,8 +18,9 @@ use glam::Vec3;
 use super::chair::{office_chair, ChairDetail, ChairPaint};
 use super::decor;
 use super::furniture::{bookcase, desk, round_table, Bookcase, Shelving};
-use super::shapes::{rect, Facing, Place, Side};
+use super::shapes::{rect, Facing, Place};
 use crate::error::Result;
+use crate::octree::Dir;
 use crate::scene::{Camera, MaterialId, SceneBuilder};
 
 /// The room's far corner.
@@ -129,9 +130,9 @@ fn office(name: &str, variant: Variant) -> Result<SceneBuilder> {
     let m = materials(&mut b, pal);
     let floor = b.diffuse("floor", pal.floor);
     let ceiling = b.diffuse("ceiling", pal.ceiling);
-    b.axis_box(Vec3::ZERO, ROOM, &[Side::Down], Facing::Inward, floor);
-    b.axis_box(Vec3::ZERO, ROOM, &[Side::Up], Facing::Inward, ceiling);
-    b.axis_box(Vec3::ZERO, ROOM, &[Side::Left, Side::Right, Side::Back, Side::Front], Facing::Inward, m.walls);
+    b.axis_box(Vec3::ZERO, ROOM, &[Dir::Down], Facing::Inward, floor);
+    b.axis_box(Vec3::ZERO, ROOM, &[Dir::Up], Facing::Inward, ceiling);
+    b.axis_box(Vec3::ZERO, ROOM, &[Dir::Left, Dir::Right, Dir::Back, Dir::Front], Facing::Inward, m.walls);
     let center = Vec3::new(0.5 * ROOM.x, ROOM.y - 0.005, 0.5 * ROOM.z);
     // X x Z = -Y: the light emits down.
     b.light("ceiling light", &rect(center, Vec3::X * 0.3, Vec3::Z * 0.3), RADIANCE);
@@ -200,7 +201,7 @@ fn work_place(b: &mut SceneBuilder, m: &Mats, variant: Variant) {
 /// Side table with a globe on a rug, plants, door, window, radiator and pictures.
 fn furnishings(b: &mut SceneBuilder, m: &Mats, variant: Variant) {
     let v = Vec3::new;
-    b.axis_box(v(0.9, 0.002, 1.4), v(2.5, 0.012, 2.7), &Side::ALL, Facing::Outward, m.accent);
+    b.axis_box(v(0.9, 0.002, 1.4), v(2.5, 0.012, 2.7), &Dir::ALL, Facing::Outward, m.accent);
     let table = Place::new(v(1.7, 0.0, 2.05), 0.0);
     round_table(b, &table, m.desk_wood, m.metal, 32);
     let globe_segments = if variant == Variant::A { 16 } else { 20 };

@@ -1,5 +1,5 @@
 //! The ten built-in test scenes of SPEC §6 (thesis chapter 7), generated in code (no files needed),
-//! deterministically and in a few milliseconds. One file per family: [`cornell`] (Cornell Cube 1-5,
+//! deterministically and in a few milliseconds. One file per family: `cornell` (Cornell Cube 1-5,
 //! millimetres), `huis` (Huis A, B, C, metres), `dragon` (Cornell Cube 2 with a creature), `boot` (a
 //! boat on the water, metres); the mesh helpers they share are in `shapes`.
 

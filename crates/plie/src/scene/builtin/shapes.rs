@@ -11,43 +11,22 @@
 
 use glam::{Vec2, Vec3};
 
+use crate::octree::Dir;
 use crate::scene::{MaterialId, SceneBuilder};
 
-/// A side of an axis-aligned box, named like the octree's directions (SPEC §3): Left/Right = -x/+x,
-/// Down/Up = -y/+y, Back/Front = -z/+z.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(crate) enum Side {
-    /// -x
-    Left,
-    /// +x
-    Right,
-    /// -y
-    Down,
-    /// +y
-    Up,
-    /// -z
-    Back,
-    /// +z
-    Front,
-}
+/// Every side of a box but the bottom: a block standing on something.
+pub(crate) const NO_BOTTOM: [Dir; 5] = [Dir::Left, Dir::Right, Dir::Up, Dir::Back, Dir::Front];
 
-impl Side {
-    /// All six sides.
-    pub(crate) const ALL: [Side; 6] = [Side::Left, Side::Right, Side::Down, Side::Up, Side::Back, Side::Front];
-    /// Every side but the bottom: a block standing on something.
-    pub(crate) const NO_BOTTOM: [Side; 5] = [Side::Left, Side::Right, Side::Up, Side::Back, Side::Front];
-
-    /// The face's corners (indices into a hexahedron's corners, see [`SceneBuilder::hexahedron`]),
-    /// counter-clockwise around the outward normal.
-    fn corners(self) -> [usize; 4] {
-        match self {
-            Side::Left => [0, 4, 6, 2],
-            Side::Right => [1, 3, 7, 5],
-            Side::Down => [0, 1, 5, 4],
-            Side::Up => [2, 6, 7, 3],
-            Side::Back => [0, 2, 3, 1],
-            Side::Front => [4, 5, 7, 6],
-        }
+/// The corners of a hexahedron's side (indices as in [`SceneBuilder::hexahedron`]), counter-clockwise
+/// around the outward normal.
+fn side_corners(side: Dir) -> [usize; 4] {
+    match side {
+        Dir::Left => [0, 4, 6, 2],
+        Dir::Right => [1, 3, 7, 5],
+        Dir::Down => [0, 1, 5, 4],
+        Dir::Up => [2, 6, 7, 3],
+        Dir::Back => [0, 2, 3, 1],
+        Dir::Front => [4, 5, 7, 6],
     }
 }
 
@@ -158,10 +137,11 @@ impl Place {
 
 impl SceneBuilder {
     /// The hexahedron with corners `c[i]`, where bit 0 of `i` is "+x", bit 1 "+y", bit 2 "+z" of a
-    /// (possibly deformed) box with positive orientation. Adds the listed sides, two triangles each.
-    pub(crate) fn hexahedron(&mut self, c: &[Vec3; 8], sides: &[Side], facing: Facing, m: MaterialId) {
+    /// (possibly deformed) box with positive orientation. Adds the listed sides (named by their outward
+    /// direction, SPEC §3), two triangles each.
+    pub(crate) fn hexahedron(&mut self, c: &[Vec3; 8], sides: &[Dir], facing: Facing, m: MaterialId) {
         for s in sides {
-            let [a, b, cc, d] = s.corners().map(|i| c[i]);
+            let [a, b, cc, d] = side_corners(*s).map(|i| c[i]);
             match facing {
                 Facing::Outward => self.quad(a, b, cc, d, m),
                 Facing::Inward => self.quad(d, cc, b, a, m),
@@ -170,7 +150,7 @@ impl SceneBuilder {
     }
 
     /// The axis-aligned box `[min, max]` with the listed sides.
-    pub(crate) fn axis_box(&mut self, min: Vec3, max: Vec3, sides: &[Side], facing: Facing, m: MaterialId) {
+    pub(crate) fn axis_box(&mut self, min: Vec3, max: Vec3, sides: &[Dir], facing: Facing, m: MaterialId) {
         let c = std::array::from_fn(|i| {
             Vec3::new(
                 if i & 1 == 0 { min.x } else { max.x },
@@ -189,7 +169,7 @@ impl SceneBuilder {
             let s = |bit: usize| if i & bit == 0 { -1.0 } else { 1.0 };
             center + u * (half.x * s(1)) + v * (half.y * s(2)) + w * (half.z * s(4))
         });
-        self.hexahedron(&c, &Side::ALL, Facing::Outward, m);
+        self.hexahedron(&c, &Dir::ALL, Facing::Outward, m);
     }
 
     /// The closed box `[min, max]` in `place`'s local coordinates (12 triangles).
@@ -203,7 +183,7 @@ impl SceneBuilder {
         let up = Vec3::Y * height;
         // Bottom corners 0, 4, 5, 1 of a box run counter-clockwise seen from above.
         let c = [base[0], base[3], base[0] + up, base[3] + up, base[1], base[2], base[1] + up, base[2] + up];
-        self.hexahedron(&c, &Side::NO_BOTTOM, Facing::Outward, m);
+        self.hexahedron(&c, &NO_BOTTOM, Facing::Outward, m);
     }
 
     /// Joins consecutive rings (see the module doc). `closed` joins the last ring to the first too.
@@ -422,9 +402,9 @@ mod tests {
 
     #[test]
     fn boxes_are_closed_and_outward() {
-        let t = built(|b, m| b.axis_box(Vec3::ZERO, Vec3::new(1.0, 2.0, 3.0), &Side::ALL, Facing::Outward, m));
+        let t = built(|b, m| b.axis_box(Vec3::ZERO, Vec3::new(1.0, 2.0, 3.0), &Dir::ALL, Facing::Outward, m));
         assert!((closed_volume(&t) - 6.0).abs() < 1e-5);
-        let t = built(|b, m| b.axis_box(Vec3::ZERO, Vec3::ONE, &Side::ALL, Facing::Inward, m));
+        let t = built(|b, m| b.axis_box(Vec3::ZERO, Vec3::ONE, &Dir::ALL, Facing::Inward, m));
         assert!((closed_volume(&t) + 1.0).abs() < 1e-5);
         let frame = [Vec3::new(0.6, 0.0, 0.8), Vec3::Y, Vec3::new(-0.8, 0.0, 0.6)];
         let t = built(|b, m| b.oriented_box(Vec3::ONE, frame, Vec3::new(1.0, 0.5, 0.25), m));
