@@ -13,11 +13,12 @@
 //!
 //! Cornell Cube 1: the thesis (§7.1) says the *right-bottom-front* octree cell lies in umbra on every
 //! face. With the root split at the scene centre (SPEC §3) that is the octant x >= 278, y <= 274.4,
-//! z >= 279.6 (the red, back, bottom corner of the room). The hovering plane is placed for it: 50 mm
-//! under the light, overhanging the light by 5 mm on the -x and -z sides and by 57 and 60 mm on the +x
-//! and +z sides, so every segment from that octant to the light crosses it (the worst case, the octant's
-//! top corner at the red wall and back wall, needs 39 and 42 mm), while the rest of the room still gets
-//! penumbra past the plane's short sides. `tests/builtin.rs` checks this by brute force.
+//! z >= 279.6 (the red, back, bottom corner of the room). The hovering plane, a 190 mm square, is
+//! placed for it: 50 mm under the light, overhanging the light by 5 mm on the -x and -z sides and by
+//! 55 and 80 mm on the +x and +z sides, so every segment from that octant to the light crosses it (the
+//! worst case, the octant's top corner at the red wall and back wall, needs 39 and 42 mm), while the
+//! rest of the room still gets penumbra past the plane's short overhangs. `tests/builtin.rs` checks
+//! this by brute force.
 
 use glam::Vec3;
 
@@ -74,10 +75,10 @@ pub(super) fn blocks(b: &mut SceneBuilder, m: MaterialId) {
     b.block_on(TALL_BLOCK, TALL_HEIGHT, m);
 }
 
-/// The plane of Cornell Cube 1, facing down, as a fan of four triangles around its centre (see the
-/// module doc for its placement).
+/// The square plane of Cornell Cube 1, facing down, as a fan of four triangles around its centre (see
+/// the module doc for its placement).
 fn hovering_plane(b: &mut SceneBuilder, m: MaterialId) {
-    let (x0, x1, z0, z1) = (208.0, 400.0, 222.0, 392.0);
+    let (x0, x1, z0, z1) = (208.0, 398.0, 222.0, 412.0);
     let y = ROOM.y - LIGHT_GAP - 50.0;
     let center = Vec3::new(0.5 * (x0 + x1), y, 0.5 * (z0 + z1));
     let c = rect(center, Vec3::X * (0.5 * (x1 - x0)), Vec3::Z * (0.5 * (z1 - z0)));
