@@ -64,4 +64,3 @@ impl Segment {
         (t0 <= t1).then_some((t0, t1))
     }
 }
-
