@@ -50,10 +50,31 @@ pub fn shared_scenes() -> Option<PathBuf> {
 pub const SHARED_OBJS: [&str; 5] =
     ["CornellBox-Original.obj", "cornell-dragon.obj", "boat-lit.obj", "cornell-bunny.obj", "cornell-dragon-100k.obj"];
 
-/// Loads the shared scenes that exist (empty where the folder is absent).
+/// The camera ../shared/scenes/README.md gives for a file, if any.
+pub fn readme_camera(file: &str) -> Option<plie::Camera> {
+    let v = Vec3::new;
+    let c = |eye, target, fov| plie::Camera::new(eye, target, Vec3::Y, fov).unwrap();
+    match file {
+        "cornell-dragon.obj" | "cornell-dragon-100k.obj" | "cornell-bunny.obj" => {
+            Some(c(v(278.0, 273.0, -800.0), v(278.0, 273.0, 0.0), 39.3))
+        }
+        "boat-lit.obj" => Some(c(v(9.0, 4.0, -9.0), v(0.0, 1.0, 0.0), 40.0)),
+        "conference-lit.obj" => Some(c(v(1550.0, 380.0, 550.0), v(400.0, 150.0, -150.0), 60.0)),
+        _ => None,
+    }
+}
+
+/// Loads the shared scenes that exist (empty where the folder is absent), with the README's cameras.
 pub fn load_shared() -> Vec<Scene> {
     let Some(dir) = shared_scenes() else { return Vec::new() };
-    SHARED_OBJS.iter().map(|f| plie::io::load_scene(&dir.join(f)).unwrap_or_else(|e| panic!("{f}: {e}"))).collect()
+    SHARED_OBJS
+        .iter()
+        .map(|f| {
+            let mut s = plie::io::load_scene(&dir.join(f)).unwrap_or_else(|e| panic!("{f}: {e}"));
+            s.camera = readme_camera(f).or(s.camera);
+            s
+        })
+        .collect()
 }
 
 /// Every built-in scene.
