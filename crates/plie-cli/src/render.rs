@@ -36,8 +36,9 @@ pub struct Args {
     /// N: N-rooks shadow rays per light per eye ray.
     #[arg(long, default_value_t = 25, value_name = "N")]
     shadow_rays: u32,
-    /// Visibility method.
-    #[arg(long, default_value = "octree", value_name = "MODE")]
+    /// Visibility method: brute (every triangle), octree (SPEC mode a), bvh (modern BVH), lie (P-LIE
+    /// blockers, SPEC mode b). All give the same image.
+    #[arg(long, default_value = "bvh", value_name = "MODE")]
     visibility: Mode,
     /// Seed of the random streams (same seed, same image, in every exact mode).
     #[arg(long, default_value_t = 0)]
@@ -54,6 +55,9 @@ pub struct Args {
     /// Use this P-LIE file (from `plie build`) instead of building one (modes that need a P-LIE).
     #[arg(long, value_name = "FILE.plie")]
     plie: Option<PathBuf>,
+    /// PNG only: scale radiance by 2^EV before tone mapping (EXR and PFM keep the exact values).
+    #[arg(long, default_value_t = 0.0, value_name = "EV", allow_hyphen_values = true)]
+    exposure: f32,
     /// Print human-readable figures on stderr.
     #[arg(long)]
     stats: bool,
@@ -75,6 +79,9 @@ pub fn run(a: &Args) -> Result<()> {
         seed: a.seed,
     };
     settings.validate()?;
+    if !a.exposure.is_finite() {
+        anyhow::bail!("--exposure must be a finite number");
+    }
     let t = Instant::now();
     let scene = a.scene.load()?;
     let load_seconds = t.elapsed().as_secs_f64();
@@ -107,7 +114,14 @@ pub fn run(a: &Args) -> Result<()> {
     let octree_seconds = t.elapsed().as_secs_f64() - plie_seconds.unwrap_or(0.0);
     let vis = visibility::for_mode(a.visibility, &scene, &bvh, &octree, plie.as_ref())?;
     let out = render(&scene, &camera, &settings, &bvh, Some(&octree), vis.as_ref(), &bar)?;
-    plie::io::save_image(&a.output, a.width, a.height, &out.pixels)
+    let pixels = match plie::io::ImageFormat::from_path(&a.output)? {
+        plie::io::ImageFormat::Png if a.exposure != 0.0 => {
+            let k = a.exposure.exp2();
+            out.pixels.iter().map(|p| *p * k).collect()
+        }
+        _ => out.pixels,
+    };
+    plie::io::save_image(&a.output, a.width, a.height, &pixels)
         .with_context(|| format!("cannot write {}", a.output.display()))?;
 
     let s = out.stats;

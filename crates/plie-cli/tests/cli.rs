@@ -96,7 +96,7 @@ fn render_writes_png_and_json() {
 fn render_pfm_is_identical_for_every_mode() {
     let dir = tempfile::tempdir().unwrap();
     let mut images = Vec::new();
-    for mode in ["brute", "octree", "bvh"] {
+    for mode in ["brute", "octree", "bvh", "lie"] {
         let out = dir.path().join(format!("{mode}.pfm"));
         let o = plie(&[
             "render",
@@ -122,8 +122,88 @@ fn render_pfm_is_identical_for_every_mode() {
         images.push(std::fs::read(&out).unwrap());
     }
     assert!(images[0].len() > 16 * 16 * 12);
-    assert_eq!(images[0], images[1]);
-    assert_eq!(images[0], images[2]);
+    assert!(images.iter().all(|i| *i == images[0]), "every mode gives the same bytes");
+}
+
+#[test]
+fn build_then_render_with_the_saved_p_lie() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("d.plie");
+    let f = file.to_str().unwrap();
+    let o = plie(&["build", "--scene", "cornell-cube-3", "-o", f, "--json"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).expect("one JSON object");
+    for key in ["build_seconds", "leaves", "records", "blockers_total", "bytes"] {
+        assert!(v.get(key).is_some(), "missing {key} in {v}");
+    }
+    assert!(v["records"].as_u64().unwrap() > 0 && v["blockers_total"].as_u64().unwrap() > 0);
+    let args = |out: &str, extra: &[&str]| {
+        let mut a = vec![
+            "render",
+            "--scene",
+            "cornell-cube-3",
+            "-o",
+            out,
+            "--width",
+            "20",
+            "--height",
+            "20",
+            "--eye-rays",
+            "1",
+            "--shadow-rays",
+            "3",
+            "--visibility",
+            "lie",
+            "--quiet",
+        ];
+        a.extend_from_slice(extra);
+        a.into_iter().map(String::from).collect::<Vec<_>>()
+    };
+    let with = dir.path().join("with.pfm");
+    let without = dir.path().join("without.pfm");
+    let run = |a: Vec<String>| Command::new(env!("CARGO_BIN_EXE_plie")).args(a).output().unwrap();
+    let o = run(args(with.to_str().unwrap(), &["--plie", f]));
+    assert!(o.status.success(), "{}", stderr(&o));
+    let o = run(args(without.to_str().unwrap(), &[]));
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_eq!(std::fs::read(&with).unwrap(), std::fs::read(&without).unwrap());
+    // The same file used for another scene, or with other parameters: refused.
+    fails_with(
+        &["render", "--scene", "cornell-cube-2", "-o", "/tmp/x.png", "--visibility", "lie", "--plie", f],
+        "another scene",
+    );
+    fails_with(
+        &[
+            "render",
+            "--scene",
+            "cornell-cube-3",
+            "-o",
+            "/tmp/x.png",
+            "--visibility",
+            "lie",
+            "--plie",
+            f,
+            "--max-triangles",
+            "50",
+        ],
+        "other parameters",
+    );
+    std::fs::write(dir.path().join("bad.plie"), b"PLIE").unwrap();
+    let bad = dir.path().join("bad.plie");
+    fails_with(
+        &[
+            "render",
+            "--scene",
+            "cornell-cube-3",
+            "-o",
+            "/tmp/x.png",
+            "--visibility",
+            "lie",
+            "--plie",
+            bad.to_str().unwrap(),
+        ],
+        "bad.plie",
+    );
 }
 
 #[test]

@@ -186,3 +186,60 @@ fn lie_mode_matches_brute_force_in_the_room() {
         assert!(blocked > 1000 && blocked < 99_000, "{blocked}");
     }
 }
+
+#[test]
+fn lie_mode_matches_brute_force_with_lights_tilted_to_grazing() {
+    use plie::visibility::{Brute, LieVisibility, QueryCtx, ShadowRay, Visibility};
+    // The room plus five lights whose normals are tilted from straight down to grazing (89.9 degrees).
+    let base = room();
+    let mut b = SceneBuilder::new("tilted");
+    let w = b.diffuse("w", Vec3::splat(0.7));
+    for t in &base.triangles {
+        if base.tri_light[base.triangles.iter().position(|u| u == t).unwrap()].is_none() {
+            b.triangle(t.v[0], t.v[1], t.v[2], w);
+        }
+    }
+    for (i, deg) in [0.0f32, 45.0, 80.0, 89.0, 89.9].iter().enumerate() {
+        let a = deg.to_radians();
+        // Emitting direction: down, rotated toward +x by `deg`.
+        let n = Vec3::new(a.sin(), -a.cos(), 0.0);
+        let u = Vec3::Z * 0.6;
+        let v = n.cross(u).normalize() * 0.6;
+        let c = Vec3::new(1.5 + 1.7 * i as f32, 8.5, 1.5 + 1.5 * i as f32);
+        // Counter-clockwise around n.
+        b.light(&format!("l{i}"), &[c - u - v, c + u - v, c + u + v, c - u + v], Vec3::ONE);
+    }
+    let scene = b.build().unwrap();
+    for (i, l) in scene.lights.iter().enumerate() {
+        assert!(l.normal.y < 0.0 || i == 4, "light {i} normal {}", l.normal);
+    }
+    let params = PlieParams { max_triangles: 8, ..PlieParams::thesis() };
+    let octree = Octree::build(&scene, params.octree());
+    let (plie, _) = plie::construct::build(&scene, &octree, params, &NoProgress);
+    let (lie, brute) = (LieVisibility::new(&scene, &octree, &plie), Brute::new(&scene));
+    let mut ctx = QueryCtx::new(scene.triangles.len());
+    let mut rng = Rng(17);
+    let (mut n, mut blocked) = (0, 0);
+    while n < 100_000 {
+        let li = n % scene.lights.len();
+        let light = &scene.lights[li];
+        let t = ((rng.f() * scene.triangles.len() as f32) as usize).min(scene.triangles.len() - 1);
+        let x = if n % 4 == 0 {
+            let c =
+                octree.leaf_bounds(LeafId((rng.f() * octree.leaf_count() as f32) as u32 % octree.leaf_count() as u32));
+            Vec3::new(c.max.x, c.min.y + rng.f() * (c.max.y - c.min.y), c.min.z)
+        } else {
+            scene.triangles[t].point(rng.f() * 0.5, rng.f() * 0.5)
+        };
+        let y = light.sample(Vec2::new(rng.f(), rng.f()));
+        if (x - y).dot(light.normal) <= 0.0 {
+            continue;
+        }
+        let ray = ShadowRay::new(x, y, LightId(li as u32), plie::TriId(t as u32), octree.locate(x));
+        let expect = brute.occluded(&ray, &mut ctx);
+        assert_eq!(lie.occluded(&ray, &mut ctx), expect, "ray {n} toward light {li}: {ray:?}");
+        blocked += expect as usize;
+        n += 1;
+    }
+    assert!(blocked > 1000 && blocked < 99_000, "{blocked}");
+}

@@ -58,7 +58,7 @@ impl Shaft {
                 for k in j + 1..n {
                     let normal = (pts[j] - pts[i]).cross(pts[k] - pts[i]);
                     let len = normal.length();
-                    if !(len > 1e-12 * scale * scale) {
+                    if len.is_nan() || len <= 1e-12 * scale * scale {
                         continue;
                     }
                     let nn = normal / len;
@@ -116,11 +116,9 @@ impl Shaft {
                 let a = cur[i];
                 let b = cur[(i + 1) % len];
                 let (da, db) = (p.distance(a), p.distance(b));
-                if da <= 0.0 {
-                    if out < next.len() {
-                        next[out] = a;
-                        out += 1;
-                    }
+                if da <= 0.0 && out < next.len() {
+                    next[out] = a;
+                    out += 1;
                 }
                 if (da <= 0.0) != (db <= 0.0) && out < next.len() {
                     let t = da / (da - db);

@@ -63,7 +63,7 @@ pub fn shade_hit(
             let y = light.sample(s.samples[k]);
             let d = y - x;
             let dist2 = d.length_squared();
-            if !(dist2 > 0.0) {
+            if dist2.is_nan() || dist2 <= 0.0 {
                 continue;
             }
             let inv_len = dist2.sqrt().recip();
