@@ -243,3 +243,23 @@ fn lie_mode_matches_brute_force_with_lights_tilted_to_grazing() {
     }
     assert!(blocked > 1000 && blocked < 99_000, "{blocked}");
 }
+
+#[test]
+fn construction_does_not_depend_on_the_thread_count() {
+    for name in ["huis-c", "dragon"] {
+        let scene = plie::scene::builtin::load(name).unwrap();
+        let params = PlieParams::thesis();
+        let build = |threads| {
+            let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+            pool.install(|| {
+                let octree = Octree::build(&scene, params.octree());
+                plie::construct::build(&scene, &octree, params, &NoProgress)
+            })
+        };
+        let (one, s1) = build(1);
+        let (two, s2) = build(2);
+        assert!(one == two, "{name}: P-LIE differs between 1 and 2 threads");
+        assert_eq!(s1.records, s2.records);
+        assert!(s1.blockers_total > 0);
+    }
+}

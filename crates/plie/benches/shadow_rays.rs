@@ -1,0 +1,58 @@
+//! Criterion benchmark: shadow-ray throughput of every visibility mode on built-in scenes, one
+//! thread, the same fixed set of shadow rays (points on triangles to light samples).
+//!
+//! Run with `cargo bench -p plie --bench shadow_rays`.
+
+use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
+use glam::Vec2;
+use plie::lie::PlieParams;
+use plie::octree::Octree;
+use plie::render::NoProgress;
+use plie::visibility::bvh::Bvh;
+use plie::visibility::{for_mode, Mode, QueryCtx, ShadowRay};
+use plie::{LightId, Scene, TriId};
+
+/// 4096 shadow rays from points on random triangles to light samples, `x` in front of the light.
+fn rays(scene: &Scene, octree: &Octree) -> Vec<ShadowRay> {
+    let mut state = 0x1234_5678_u64;
+    let mut next = move || {
+        state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        ((state >> 40) as f32) / (1u64 << 24) as f32
+    };
+    let mut out = Vec::new();
+    while out.len() < 4096 {
+        let t = ((next() * scene.triangles.len() as f32) as usize).min(scene.triangles.len() - 1);
+        let li = ((next() * scene.lights.len() as f32) as usize).min(scene.lights.len() - 1);
+        let (u, v) = (next() * 0.5, next() * 0.5);
+        let x = scene.triangles[t].point(u, v);
+        let y = scene.lights[li].sample(Vec2::new(next(), next()));
+        if (x - y).dot(scene.lights[li].normal) > 0.0 && scene.tri_light[t].is_none() {
+            out.push(ShadowRay::new(x, y, LightId(li as u32), TriId(t as u32), octree.locate(x)));
+        }
+    }
+    out
+}
+
+fn bench(c: &mut Criterion) {
+    for name in ["cornell-cube-3", "huis-a", "dragon", "boot"] {
+        let scene = plie::scene::builtin::load(name).expect("built-in scene");
+        let params = PlieParams::thesis();
+        let octree = Octree::build(&scene, params.octree());
+        let (plie, _) = plie::construct::build(&scene, &octree, params, &NoProgress);
+        let bvh = Bvh::build(&scene);
+        let rays = rays(&scene, &octree);
+        let mut group = c.benchmark_group(format!("shadow_rays/{name}"));
+        group.throughput(Throughput::Elements(rays.len() as u64));
+        for mode in Mode::ALL.into_iter().filter(|m| *m != Mode::Brute) {
+            let vis = for_mode(mode, &scene, &bvh, &octree, Some(&plie)).expect("mode");
+            let mut ctx = QueryCtx::new(scene.triangle_count());
+            group.bench_with_input(BenchmarkId::from_parameter(mode), &rays, |b, rays| {
+                b.iter(|| rays.iter().filter(|r| vis.occluded(r, &mut ctx)).count())
+            });
+        }
+        group.finish();
+    }
+}
+
+criterion_group!(benches, bench);
+criterion_main!(benches);
