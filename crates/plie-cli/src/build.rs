@@ -23,6 +23,9 @@ pub struct Args {
     /// Octree: split leaves holding more triangles than this.
     #[arg(long, default_value_t = 200, value_name = "N")]
     max_triangles: usize,
+    /// P-LIE: skip the face grids (per-cell blocker lists used by `--visibility grid`).
+    #[arg(long)]
+    no_grids: bool,
     /// Octree: maximum depth.
     #[arg(long, default_value_t = OctreeParams::default().max_depth, value_name = "D")]
     max_depth: u32,
@@ -40,7 +43,7 @@ pub struct Args {
 pub fn run(a: &Args) -> Result<()> {
     crate::scenes::set_threads(a.threads)?;
     let scene = a.scene.load()?;
-    let params = PlieParams { max_triangles: a.max_triangles, max_depth: a.max_depth };
+    let params = PlieParams { max_triangles: a.max_triangles, max_depth: a.max_depth, grids: !a.no_grids };
     params.octree().validate()?;
     let bar = Bar::new(a.quiet || a.json);
     let t_all = Instant::now();
@@ -76,6 +79,10 @@ pub fn run(a: &Args) -> Result<()> {
             "blockers_total": stats.blockers_total,
             "blockers_mean": stats.blockers_mean,
             "blockers_max": stats.blockers_max,
+            "grids": stats.grids,
+            "grid_cells": plie.cells.len(),
+            "grid_cells_lit": stats.grid_cells_lit,
+            "grid_blockers_total": plie.cell_blockers.len(),
             "bytes": memory,
             "file_bytes": file_bytes,
             "output": a.output.display().to_string(),
@@ -101,6 +108,17 @@ pub fn run(a: &Args) -> Result<()> {
             stats.candidates_clipped,
             stats.blockers_seconds
         );
+        if a.no_grids {
+            println!("face grids      none (--no-grids)");
+        } else {
+            println!(
+                "face grids      {} records with a grid, {} cells ({} fully lit), {} cell blocker references",
+                stats.grids,
+                plie.cells.len(),
+                stats.grid_cells_lit,
+                plie.cell_blockers.len()
+            );
+        }
         println!("build           {build_seconds:.3} s");
         println!("memory          {memory} bytes (octree {} + P-LIE {})", octree.memory_bytes(), plie.memory_bytes());
         println!("file            {} ({file_bytes} bytes, written in {write_seconds:.3} s)", a.output.display());

@@ -49,6 +49,9 @@ pub struct Args {
     /// Octree: split leaves holding more triangles than this.
     #[arg(long, default_value_t = 200, value_name = "N")]
     max_triangles: usize,
+    /// P-LIE: skip the face grids (per-cell blocker lists used by `--visibility grid`).
+    #[arg(long)]
+    no_grids: bool,
     /// Octree: maximum depth.
     #[arg(long, default_value_t = OctreeParams::default().max_depth, value_name = "D")]
     max_depth: u32,
@@ -95,7 +98,7 @@ pub fn run(a: &Args) -> Result<()> {
     let bvh = Bvh::build(&scene);
     let bvh_seconds = t.elapsed().as_secs_f64();
     let bar = Bar::new(a.quiet || a.json);
-    let params = PlieParams { max_triangles: a.max_triangles, max_depth: a.max_depth };
+    let params = PlieParams { max_triangles: a.max_triangles, max_depth: a.max_depth, grids: !a.no_grids };
     params.octree().validate()?;
     let t = Instant::now();
     let (octree, plie, plie_seconds, load_plie_seconds) = match (&a.plie, a.visibility.needs_plie()) {

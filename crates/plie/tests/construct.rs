@@ -157,10 +157,12 @@ fn lie_mode_matches_brute_force_in_the_room() {
     use plie::visibility::{Brute, LieVisibility, QueryCtx, ShadowRay, Visibility};
     let scene = room();
     for max_triangles in [8, 200] {
-        let params = PlieParams { max_triangles, ..PlieParams::thesis() };
+        let params = PlieParams { max_triangles, ..PlieParams::default() };
         let octree = Octree::build(&scene, params.octree());
-        let (plie, _) = plie::construct::build(&scene, &octree, params, &NoProgress);
+        let (plie, stats) = plie::construct::build(&scene, &octree, params, &NoProgress);
+        assert!(stats.grids > 0);
         let (lie, brute) = (LieVisibility::new(&scene, &octree, &plie), Brute::new(&scene));
+        let grid = LieVisibility::with_grids(&scene, &octree, &plie);
         let mut ctx = QueryCtx::new(scene.triangles.len());
         let mut rng = Rng(5);
         let light = &scene.lights[0];
@@ -179,7 +181,8 @@ fn lie_mode_matches_brute_force_in_the_room() {
             }
             let ray = ShadowRay::new(x, y, LightId(0), plie::TriId(t as u32), octree.locate(x));
             let expect = brute.occluded(&ray, &mut ctx);
-            assert_eq!(lie.occluded(&ray, &mut ctx), expect, "ray {n}: {ray:?}");
+            assert_eq!(lie.occluded(&ray, &mut ctx), expect, "lie, ray {n}: {ray:?}");
+            assert_eq!(grid.occluded(&ray, &mut ctx), expect, "grid, ray {n}: {ray:?}");
             blocked += expect as usize;
             n += 1;
         }
@@ -213,10 +216,11 @@ fn lie_mode_matches_brute_force_with_lights_tilted_to_grazing() {
     for (i, l) in scene.lights.iter().enumerate() {
         assert!(l.normal.y < 0.0 || i == 4, "light {i} normal {}", l.normal);
     }
-    let params = PlieParams { max_triangles: 8, ..PlieParams::thesis() };
+    let params = PlieParams { max_triangles: 8, ..PlieParams::default() };
     let octree = Octree::build(&scene, params.octree());
     let (plie, _) = plie::construct::build(&scene, &octree, params, &NoProgress);
     let (lie, brute) = (LieVisibility::new(&scene, &octree, &plie), Brute::new(&scene));
+    let grid = LieVisibility::with_grids(&scene, &octree, &plie);
     let mut ctx = QueryCtx::new(scene.triangles.len());
     let mut rng = Rng(17);
     let (mut n, mut blocked) = (0, 0);
@@ -237,7 +241,8 @@ fn lie_mode_matches_brute_force_with_lights_tilted_to_grazing() {
         }
         let ray = ShadowRay::new(x, y, LightId(li as u32), plie::TriId(t as u32), octree.locate(x));
         let expect = brute.occluded(&ray, &mut ctx);
-        assert_eq!(lie.occluded(&ray, &mut ctx), expect, "ray {n} toward light {li}: {ray:?}");
+        assert_eq!(lie.occluded(&ray, &mut ctx), expect, "lie, ray {n} toward light {li}: {ray:?}");
+        assert_eq!(grid.occluded(&ray, &mut ctx), expect, "grid, ray {n} toward light {li}: {ray:?}");
         blocked += expect as usize;
         n += 1;
     }
@@ -262,4 +267,41 @@ fn construction_does_not_depend_on_the_thread_count() {
         assert_eq!(s1.records, s2.records);
         assert!(s1.blockers_total > 0);
     }
+}
+
+#[test]
+fn grid_cells_contain_every_triangle_between_cell_and_light() {
+    use plie::construct::grid::cell_box;
+    let scene = room();
+    let params = PlieParams { max_triangles: 64, ..PlieParams::default() };
+    let octree = Octree::build(&scene, params.octree());
+    let (plie, stats) = plie::construct::build(&scene, &octree, params, &NoProgress);
+    assert!(stats.grids > 0, "{stats:?}");
+    let mut rng = Rng(23);
+    let mut checked = 0;
+    for (r, g) in plie.records.iter().zip(&plie.grids) {
+        if g.res == 0 {
+            continue;
+        }
+        let light = &scene.lights[r.light.idx()];
+        let leaf = octree.leaf_bounds(r.leaf);
+        for j in 0..g.res {
+            for i in 0..g.res {
+                let list = plie.cell_blockers_of(g, (j * g.res + i) as usize);
+                let q = r.face.face_corners(&cell_box(r.face, &leaf, g.res, i, j));
+                for _ in 0..16 {
+                    let f = q[0] + (q[1] - q[0]) * rng.f() + (q[3] - q[0]) * rng.f();
+                    let y = light.sample(Vec2::new(rng.f(), rng.f()));
+                    for t in 0..scene.triangles.len() {
+                        if scene.tri_light[t] == Some(r.light) || !hits_any_t(&scene, f, y, t) {
+                            continue;
+                        }
+                        checked += 1;
+                        assert!(list.contains(&plie::TriId(t as u32)), "triangle {t} missing from cell ({i}, {j})");
+                    }
+                }
+            }
+        }
+    }
+    assert!(checked > 100, "{checked}");
 }

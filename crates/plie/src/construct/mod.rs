@@ -4,12 +4,14 @@
 //! 1. [`data_objects`]: which (leaf, face, light) need a record (§4.1, exact condition).
 //! 2. [`shaft`]: bounding volume and supporting planes of conv(face ∪ light) (§4.2, §4.3).
 //! 3. [`blockers`]: gather candidates from the overlapping leaves, de-duplicate, clip (§4.4).
+//! 4. [`grid`]: per record, a face grid of per-cell blocker lists (our addition, SPEC §8).
 //!
 //! Umbra/penumbra (§4.5), removal (§4.6), propagation (§4.7) and refinement (§4.8) come later.
 //! Leaves are processed in parallel with rayon; the result does not depend on the thread count.
 
 pub mod blockers;
 pub mod data_objects;
+pub mod grid;
 pub mod shaft;
 
 use std::time::Instant;
@@ -17,7 +19,7 @@ use std::time::Instant;
 use rayon::prelude::*;
 use serde::Serialize;
 
-use crate::lie::{Plie, PlieParams, Record, NO_RECORD};
+use crate::lie::{FaceGrid, Plie, PlieParams, Record, NO_RECORD};
 use crate::octree::{Dir, LeafId, Octree};
 use crate::render::Progress;
 use crate::scene::{LightId, Scene, TriId};
@@ -46,14 +48,20 @@ pub struct BuildStats {
     pub blockers_mean: f64,
     /// Most blockers on one record.
     pub blockers_max: u32,
+    /// Records with a face grid.
+    pub grids: usize,
+    /// Grid cells with no blocker at all (fully lit).
+    pub grid_cells_lit: usize,
     /// Seconds building the octree.
     pub octree_seconds: f64,
     /// Seconds computing data objects, shafts and blockers.
     pub blockers_seconds: f64,
 }
 
-/// The records of one leaf before flattening: (face, light, blockers).
-type LeafRecords = Vec<(Dir, LightId, Vec<TriId>)>;
+/// One record before flattening: face, light, blockers and the optional face grid.
+type PendingRecord = (Dir, LightId, Vec<TriId>, Option<(u32, Vec<Vec<TriId>>)>);
+/// The records of one leaf before flattening.
+type LeafRecords = Vec<PendingRecord>;
 
 /// Builds the P-LIE of `scene` over `octree` (stages 1-3).
 pub fn build(scene: &Scene, octree: &Octree, params: PlieParams, progress: &dyn Progress) -> (Plie, BuildStats) {
@@ -66,7 +74,7 @@ pub fn build(scene: &Scene, octree: &Octree, params: PlieParams, progress: &dyn 
         .map_init(
             || GatherScratch::new(scene.triangles.len()),
             |scratch, l| {
-                let r = leaf_records(scene, octree, LeafId(l), tol, scratch);
+                let r = leaf_records(scene, octree, LeafId(l), tol, params.grids, scratch);
                 progress.advance(1);
                 r
             },
@@ -86,10 +94,24 @@ pub fn build(scene: &Scene, octree: &Octree, params: PlieParams, progress: &dyn 
         record_index: vec![NO_RECORD; octree.leaf_count() * 6 * lights],
         records: Vec::new(),
         blockers: Vec::new(),
+        grids: Vec::new(),
+        cells: Vec::new(),
+        cell_blockers: Vec::new(),
     };
     for (l, (records, candidates)) in per_leaf.into_iter().enumerate() {
         stats.candidates_clipped += candidates;
-        for (face, light, blockers) in records {
+        for (face, light, blockers, grid) in records {
+            let mut fg = FaceGrid::default();
+            if let Some((res, cells)) = grid {
+                fg = FaceGrid { res, cells_start: plie.cells.len() as u32 };
+                stats.grids += 1;
+                for c in cells {
+                    stats.grid_cells_lit += c.is_empty() as usize;
+                    plie.cells.push((plie.cell_blockers.len() as u32, c.len() as u32));
+                    plie.cell_blockers.extend(c);
+                }
+            }
+            plie.grids.push(fg);
             let i = (l * 6 + face.index()) * lights + light.idx();
             plie.record_index[i] = plie.records.len() as u32;
             plie.records.push(Record {
@@ -116,6 +138,7 @@ fn leaf_records(
     octree: &Octree,
     leaf: LeafId,
     tol: f32,
+    grids: bool,
     scratch: &mut GatherScratch,
 ) -> (LeafRecords, usize) {
     let b = octree.leaf_bounds(leaf);
@@ -130,7 +153,8 @@ fn leaf_records(
             let shaft = Shaft::new(&corners, &light.vertices, tol);
             let mut blockers = Vec::new();
             candidates += gather_blockers(scene, octree, &shaft, LightId(li as u32), scratch, &mut blockers);
-            out.push((face, LightId(li as u32), blockers));
+            let grid = if grids { grid::face_grid(scene, face, &b, light, &blockers, tol) } else { None };
+            out.push((face, LightId(li as u32), blockers, grid));
         }
     }
     (out, candidates)

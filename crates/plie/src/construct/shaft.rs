@@ -103,6 +103,21 @@ impl Shaft {
     /// True if the triangle has a non-empty intersection with the (grown) shaft: Sutherland-Hodgman
     /// clipping of the triangle by every plane (SPEC §4.4 step 3).
     pub fn clips_triangle(&self, tri: &[Vec3; 3]) -> bool {
+        // Quick answers first: all vertices beyond one plane (outside), or one vertex inside all.
+        let v = tri.map(|p| p.as_dvec3());
+        let mut inside = [true; 3];
+        for p in &self.planes {
+            let d = v.map(|q| p.distance(q));
+            if d.iter().all(|&x| x > 0.0) {
+                return false;
+            }
+            for (ins, x) in inside.iter_mut().zip(d) {
+                *ins &= x <= 0.0;
+            }
+        }
+        if inside.iter().any(|&i| i) {
+            return true;
+        }
         let mut buf_a = [DVec3::ZERO; 3 + 2 * MAX_POINTS * MAX_POINTS];
         let mut buf_b = buf_a;
         let mut len = 3;

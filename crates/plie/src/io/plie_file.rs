@@ -191,8 +191,19 @@ fn check_structure(p: &Plie, scene: &Scene, octree: &Octree) -> std::result::Res
             return Err(format!("record {i}: blocker range out of bounds"));
         }
     }
-    if let Some(t) = p.blockers.iter().find(|t| t.idx() >= scene.triangles.len()) {
+    if let Some(t) = p.blockers.iter().chain(&p.cell_blockers).find(|t| t.idx() >= scene.triangles.len()) {
         return Err(format!("blocker triangle {} out of range", t.0));
+    }
+    if p.grids.len() != p.records.len() {
+        return Err("grid table has the wrong size".into());
+    }
+    for (i, g) in p.grids.iter().enumerate() {
+        if g.res > 64 || g.cells_start as u64 + (g.res as u64 * g.res as u64) > p.cells.len() as u64 {
+            return Err(format!("record {i}: face grid out of bounds"));
+        }
+    }
+    if p.cells.iter().any(|&(s, n)| s as u64 + n as u64 > p.cell_blockers.len() as u64) {
+        return Err("grid cell list out of bounds".into());
     }
     Ok(())
 }

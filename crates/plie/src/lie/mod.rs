@@ -20,13 +20,15 @@ pub struct PlieParams {
     pub max_triangles: usize,
     /// Octree: maximum depth.
     pub max_depth: u32,
+    /// Build face grids (per-cell blocker lists, our addition; used by mode `grid`).
+    pub grids: bool,
 }
 
 impl PlieParams {
-    /// The thesis' test 1: 200 triangles per leaf, no refinement.
+    /// The thesis' test 1: 200 triangles per leaf, no refinement, nothing the thesis did not have.
     pub fn thesis() -> PlieParams {
         let o = crate::octree::OctreeParams::thesis();
-        PlieParams { max_triangles: o.max_triangles, max_depth: o.max_depth }
+        PlieParams { max_triangles: o.max_triangles, max_depth: o.max_depth, grids: false }
     }
 
     /// The octree part of the parameters.
@@ -36,8 +38,9 @@ impl PlieParams {
 }
 
 impl Default for PlieParams {
+    /// The thesis' parameters plus face grids.
     fn default() -> PlieParams {
-        PlieParams::thesis()
+        PlieParams { grids: true, ..PlieParams::thesis() }
     }
 }
 
@@ -56,6 +59,16 @@ pub struct Record {
     pub blockers_len: u32,
 }
 
+/// A record's face grid (see [`crate::construct::grid`]): `res x res` cells whose blocker lists are
+/// `cells[cells_start .. cells_start + res * res]`. `res == 0`: no grid, use the record's list.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub struct FaceGrid {
+    /// Cells per side (0: no grid).
+    pub res: u32,
+    /// First cell in [`Plie::cells`].
+    pub cells_start: u32,
+}
+
 /// The preprocessed local illumination environments of every leaf.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Plie {
@@ -71,6 +84,12 @@ pub struct Plie {
     pub records: Vec<Record>,
     /// All blocker lists, concatenated.
     pub blockers: Vec<TriId>,
+    /// The face grid of each record (parallel to `records`).
+    pub grids: Vec<FaceGrid>,
+    /// Grid cells: `(start, len)` into `cell_blockers`.
+    pub cells: Vec<(u32, u32)>,
+    /// All cell blocker lists, concatenated.
+    pub cell_blockers: Vec<TriId>,
 }
 
 impl Plie {
@@ -84,10 +103,27 @@ impl Plie {
         }
     }
 
+    /// The index of the record of (leaf, face, light) in [`Plie::records`], if any.
+    #[inline]
+    pub fn record_id(&self, leaf: LeafId, face: Dir, light: LightId) -> Option<usize> {
+        let i = (leaf.idx() * 6 + face.index()) * self.lights as usize + light.idx();
+        match self.record_index[i] {
+            NO_RECORD => None,
+            r => Some(r as usize),
+        }
+    }
+
     /// A record's blockers.
     #[inline]
     pub fn blockers_of(&self, r: &Record) -> &[TriId] {
         &self.blockers[r.blockers_start as usize..(r.blockers_start + r.blockers_len) as usize]
+    }
+
+    /// The blockers of cell `c` of record `r`'s grid.
+    #[inline]
+    pub fn cell_blockers_of(&self, grid: &FaceGrid, c: usize) -> &[TriId] {
+        let (s, n) = self.cells[grid.cells_start as usize + c];
+        &self.cell_blockers[s as usize..(s + n) as usize]
     }
 
     /// Bytes held in memory by the P-LIE's arrays.
@@ -95,6 +131,9 @@ impl Plie {
         self.record_index.len() * 4
             + self.records.len() * std::mem::size_of::<Record>()
             + self.blockers.len() * std::mem::size_of::<TriId>()
+            + self.grids.len() * std::mem::size_of::<FaceGrid>()
+            + self.cells.len() * 8
+            + self.cell_blockers.len() * std::mem::size_of::<TriId>()
     }
 
     /// Mean and maximum blockers per record.

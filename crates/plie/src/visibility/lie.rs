@@ -4,6 +4,7 @@
 //! of `c` itself (the part inside `c`). A segment that never leaves `c` only needs `c`'s triangles.
 
 use super::{blocks, OctreeVisibility, QueryCtx, ShadowRay, Visibility};
+use crate::construct::grid;
 use crate::geometry::{Aabb, Segment};
 use crate::lie::Plie;
 use crate::octree::{Dir, LeafId, Octree};
@@ -19,6 +20,8 @@ pub struct LieVisibility<'a> {
     plie: &'a Plie,
     /// Grown bounding box of every triangle.
     tri_boxes: Vec<Aabb>,
+    /// Use the records' face grids (mode `grid`) instead of their whole lists (mode `lie`).
+    use_grids: bool,
 }
 
 impl<'a> LieVisibility<'a> {
@@ -26,7 +29,13 @@ impl<'a> LieVisibility<'a> {
     pub fn new(scene: &'a Scene, octree: &'a Octree, plie: &'a Plie) -> LieVisibility<'a> {
         let pad = scene.scale() * crate::construct::TOLERANCE_REL;
         let tri_boxes = scene.triangles.iter().map(|t| t.aabb().expanded(pad)).collect();
-        LieVisibility { scene, octree, plie, tri_boxes }
+        LieVisibility { scene, octree, plie, tri_boxes, use_grids: false }
+    }
+
+    /// Mode `grid`: as mode (b), but a ray tests only the blockers of the face-grid cell where it
+    /// crosses the face (see [`crate::construct::grid`]).
+    pub fn with_grids(scene: &'a Scene, octree: &'a Octree, plie: &'a Plie) -> LieVisibility<'a> {
+        LieVisibility { use_grids: true, ..LieVisibility::new(scene, octree, plie) }
     }
 
     /// The box cull, then the shared predicate.
@@ -36,10 +45,10 @@ impl<'a> LieVisibility<'a> {
     }
 }
 
-/// The face through which the segment `ray` leaves the box of `leaf`, or `None` if it stays inside
-/// for its whole open range.
+/// The face through which the segment `ray` leaves the box of `leaf` and the segment parameter where
+/// it does, or `None` if it stays inside for its whole open range.
 #[inline]
-pub fn exit_face(octree: &Octree, leaf: LeafId, ray: &ShadowRay) -> Option<Dir> {
+pub fn exit_face(octree: &Octree, leaf: LeafId, ray: &ShadowRay) -> Option<(Dir, f32)> {
     let b = octree.leaf_bounds(leaf);
     let (o, d) = (ray.test.origin, ray.test.dir);
     let mut best = (ray.test.t_max, None);
@@ -55,7 +64,7 @@ pub fn exit_face(octree: &Octree, leaf: LeafId, ray: &ShadowRay) -> Option<Dir> 
             best = (t, Some(Dir::from_axis(k, positive)));
         }
     }
-    best.1
+    best.1.map(|d| (d, best.0))
 }
 
 impl Visibility for LieVisibility<'_> {
@@ -65,11 +74,19 @@ impl Visibility for LieVisibility<'_> {
             return OctreeVisibility::new(self.scene, self.octree).occluded(ray, ctx);
         };
         let seg = Segment::new(ray.test.origin, ray.test.dir, ray.test.t_min, ray.test.t_max);
-        if let Some(face) = exit_face(self.octree, leaf, ray) {
-            let Some(record) = self.plie.record(leaf, face, ray.light) else {
+        if let Some((face, t_exit)) = exit_face(self.octree, leaf, ray) {
+            let Some(ri) = self.plie.record_id(leaf, face, ray.light) else {
                 return true;
             };
-            for &t in self.plie.blockers_of(record) {
+            let grid = &self.plie.grids[ri];
+            let list = if self.use_grids && grid.res > 0 {
+                let f = ray.test.origin + ray.test.dir * t_exit;
+                let c = grid::cell_of(face, &self.octree.leaf_bounds(leaf), grid.res, f);
+                self.plie.cell_blockers_of(grid, c)
+            } else {
+                self.plie.blockers_of(&self.plie.records[ri])
+            };
+            for &t in list {
                 if self.test(&seg, ray, t, ctx) {
                     return true;
                 }

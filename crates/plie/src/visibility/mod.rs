@@ -37,9 +37,12 @@ pub fn for_mode<'a>(
         Mode::Brute => Box::new(Brute::new(scene)),
         Mode::Octree => Box::new(OctreeVisibility::new(scene, octree)),
         Mode::Bvh => Box::new(BvhVisibility::new(scene, bvh)),
-        Mode::Lie => {
+        Mode::Lie | Mode::Grid => {
             let plie = plie.ok_or_else(|| crate::Error::InvalidParameter(format!("mode {mode} needs a P-LIE")))?;
-            Box::new(LieVisibility::new(scene, octree, plie))
+            match mode {
+                Mode::Grid => Box::new(LieVisibility::with_grids(scene, octree, plie)),
+                _ => Box::new(LieVisibility::new(scene, octree, plie)),
+            }
         }
     })
 }

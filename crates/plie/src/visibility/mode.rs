@@ -15,11 +15,13 @@ pub enum Mode {
     Bvh,
     /// SPEC §5 mode (b): the P-LIE's blocker lists.
     Lie,
+    /// Mode (b) with face grids: only the blockers of the cell where the ray crosses the face.
+    Grid,
 }
 
 impl Mode {
     /// Every mode, for tests that compare them all.
-    pub const ALL: [Mode; 4] = [Mode::Brute, Mode::Octree, Mode::Bvh, Mode::Lie];
+    pub const ALL: [Mode; 5] = [Mode::Brute, Mode::Octree, Mode::Bvh, Mode::Lie, Mode::Grid];
 
     /// The name used on the command line.
     pub fn name(self) -> &'static str {
@@ -28,12 +30,13 @@ impl Mode {
             Mode::Octree => "octree",
             Mode::Bvh => "bvh",
             Mode::Lie => "lie",
+            Mode::Grid => "grid",
         }
     }
 
     /// True if the mode answers from a P-LIE.
     pub fn needs_plie(self) -> bool {
-        matches!(self, Mode::Lie)
+        matches!(self, Mode::Lie | Mode::Grid)
     }
 }
 

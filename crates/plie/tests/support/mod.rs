@@ -91,6 +91,7 @@ pub struct Built {
 
 impl Built {
     pub fn new(scene: &Scene, params: plie::lie::PlieParams) -> Built {
+        let params = plie::lie::PlieParams { grids: true, ..params };
         let bvh = plie::visibility::bvh::Bvh::build(scene);
         let octree = plie::octree::Octree::build(scene, params.octree());
         let (plie, _) = plie::construct::build(scene, &octree, params, &plie::render::NoProgress);

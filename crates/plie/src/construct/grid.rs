@@ -1,0 +1,119 @@
+//! Face grids (SPEC §8 points 3-4, our improvement over the thesis; part of issue 4's `grid`): a
+//! record's face is split into `g x g` cells, and each cell keeps only the blockers that meet the shaft
+//! from that cell to the light. A shadow ray looks up the cell where it crosses the face in O(1) and
+//! tests that list; an empty list means the cell is fully lit from the light (no blocker at all).
+//!
+//! Each cell's list is found exactly as a record's list is (SPEC §4.4): the supporting planes of
+//! conv(cell ∪ light), moved outward by the tolerance, clip the record's blockers. Because of that
+//! tolerance, a crossing point computed with rounding error near a cell border is still covered by the
+//! cell it is assigned to. (Umbra cells need the regions of SPEC §4.5 and are not classified here.)
+
+use super::shaft::Shaft;
+use crate::geometry::Aabb;
+use crate::octree::Dir;
+use crate::scene::{Light, Scene, TriId};
+
+/// Records with fewer blockers than this keep no grid: their list is short already.
+pub const MIN_BLOCKERS: usize = 8;
+
+/// Cells per side for a record with `n` blockers: a power of two near `sqrt(n) / 2`, from 2 to 8.
+pub fn resolution(n: usize) -> u32 {
+    let want = ((n as f64).sqrt() / 2.0).ceil().clamp(2.0, 8.0) as u32;
+    want.next_power_of_two().min(8)
+}
+
+/// The two in-face axes of a face along `axis`: the same `(u, v)` as [`Dir::face_corners`].
+#[inline]
+pub fn face_axes(axis: usize) -> (usize, usize) {
+    ((axis + 1) % 3, (axis + 2) % 3)
+}
+
+/// The box of cell `(i, j)` of face `face` of `cell` (flat along the face's axis).
+pub fn cell_box(face: Dir, cell: &Aabb, g: u32, i: u32, j: u32) -> Aabb {
+    let k = face.axis();
+    let (u, v) = face_axes(k);
+    let w = if face.is_positive() { cell.max[k] } else { cell.min[k] };
+    let (mut lo, mut hi) = (cell.min, cell.max);
+    lo[k] = w;
+    hi[k] = w;
+    let du = (cell.max[u] - cell.min[u]) / g as f32;
+    let dv = (cell.max[v] - cell.min[v]) / g as f32;
+    lo[u] = cell.min[u] + du * i as f32;
+    hi[u] = if i + 1 == g { cell.max[u] } else { cell.min[u] + du * (i + 1) as f32 };
+    lo[v] = cell.min[v] + dv * j as f32;
+    hi[v] = if j + 1 == g { cell.max[v] } else { cell.min[v] + dv * (j + 1) as f32 };
+    Aabb::new(lo, hi)
+}
+
+/// The grid of one record: `g` and the `g * g` cell lists (cell `(i, j)` at `j * g + i`), or `None`
+/// when the record has too few blockers to need one.
+pub fn face_grid(
+    scene: &Scene,
+    face: Dir,
+    cell: &Aabb,
+    light: &Light,
+    blockers: &[TriId],
+    tol: f32,
+) -> Option<(u32, Vec<Vec<TriId>>)> {
+    if blockers.len() < MIN_BLOCKERS {
+        return None;
+    }
+    let g = resolution(blockers.len());
+    let mut cells = vec![Vec::new(); (g * g) as usize];
+    let quad = Quad { scene, face, cell, light, tol, g };
+    quad.split(0, 0, g, blockers, &mut cells);
+    Some((g, cells))
+}
+
+/// The quadtree walk that fills a grid: each square of cells filters its parent's list, so deep
+/// cells clip only the few blockers that reached them.
+struct Quad<'a> {
+    scene: &'a Scene,
+    face: Dir,
+    cell: &'a Aabb,
+    light: &'a Light,
+    tol: f32,
+    g: u32,
+}
+
+impl Quad<'_> {
+    /// The blockers of `parent` that meet the shaft from the square of `size` cells at `(i, j)`.
+    fn filter(&self, i: u32, j: u32, size: u32, parent: &[TriId]) -> Vec<TriId> {
+        let lo = cell_box(self.face, self.cell, self.g, i, j);
+        let hi = cell_box(self.face, self.cell, self.g, i + size - 1, j + size - 1);
+        let corners = self.face.face_corners(&lo.union(hi));
+        let shaft = Shaft::new(&corners, &self.light.vertices, self.tol);
+        parent
+            .iter()
+            .copied()
+            .filter(|t| {
+                let tri = &self.scene.triangles[t.idx()];
+                shaft.bounds.overlaps(&tri.aabb()) && shaft.clips_triangle(&tri.v)
+            })
+            .collect()
+    }
+
+    /// Splits the square of `size` cells at `(i, j)` into four and recurses down to single cells.
+    fn split(&self, i: u32, j: u32, size: u32, list: &[TriId], cells: &mut [Vec<TriId>]) {
+        let half = size / 2;
+        for (di, dj) in [(0, 0), (half, 0), (0, half), (half, half)] {
+            let sub = self.filter(i + di, j + dj, half, list);
+            if half == 1 {
+                cells[((j + dj) * self.g + i + di) as usize] = sub;
+            } else if !sub.is_empty() {
+                self.split(i + di, j + dj, half, &sub, cells);
+            }
+        }
+    }
+}
+
+/// The cell of a `g x g` face grid that the face point `p` falls in (clamped to the face).
+#[inline]
+pub fn cell_of(face: Dir, cell: &Aabb, g: u32, p: glam::Vec3) -> usize {
+    let (u, v) = face_axes(face.axis());
+    let fu = (p[u] - cell.min[u]) / (cell.max[u] - cell.min[u]) * g as f32;
+    let fv = (p[v] - cell.min[v]) / (cell.max[v] - cell.min[v]) * g as f32;
+    let i = (fu.max(0.0) as u32).min(g - 1);
+    let j = (fv.max(0.0) as u32).min(g - 1);
+    (j * g + i) as usize
+}
