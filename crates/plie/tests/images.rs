@@ -10,13 +10,20 @@ use plie::visibility::Mode;
 use plie::Scene;
 use support::Built;
 
-fn image(scene: &Scene, mode: Mode, threads: usize, settings: &RenderSettings) -> Vec<Vec3> {
+/// Every mode's image, rendered in a pool of `threads` threads (structures built in that pool too).
+fn images(scene: &Scene, threads: usize, settings: &RenderSettings) -> Vec<(Mode, Vec<Vec3>)> {
     let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
     pool.install(|| {
-        let built = Built::new(scene, PlieParams::thesis());
-        let vis = built.vis(scene, mode);
+        let built = Built::new(scene, PlieParams::default());
         let camera = scene.camera_or_default();
-        render(scene, &camera, settings, &built.bvh, Some(&built.octree), vis.as_ref(), &NoProgress).unwrap().pixels
+        Mode::ALL
+            .into_iter()
+            .map(|mode| {
+                let vis = built.vis(scene, mode);
+                let px = render(scene, &camera, settings, &built.bvh, Some(&built.octree), vis.as_ref(), &NoProgress);
+                (mode, px.unwrap().pixels)
+            })
+            .collect()
     })
 }
 
@@ -25,16 +32,14 @@ fn bits(p: &[Vec3]) -> Vec<[u32; 3]> {
 }
 
 fn check(scene: &Scene, settings: &RenderSettings) {
-    let reference = bits(&image(scene, Mode::Brute, 2, settings));
+    let two = images(scene, 2, settings);
+    let reference = bits(&two[0].1);
+    assert_eq!(two[0].0, Mode::Brute);
     let lit = reference.iter().filter(|p| p.iter().any(|&c| f32::from_bits(c) > 0.0)).count();
     assert!(lit > reference.len() / 4, "{}: the image is mostly black ({lit} lit pixels)", scene.name);
-    for mode in Mode::ALL {
-        for threads in [1, 2] {
-            if mode == Mode::Brute && threads == 2 {
-                continue;
-            }
-            let got = bits(&image(scene, mode, threads, settings));
-            let diff = got.iter().zip(&reference).filter(|(a, b)| a != b).count();
+    for (threads, set) in [(2, two), (1, images(scene, 1, settings))] {
+        for (mode, px) in set {
+            let diff = bits(&px).iter().zip(&reference).filter(|(a, b)| a != b).count();
             assert_eq!(diff, 0, "{}: {mode} with {threads} threads differs from brute in {diff} pixels", scene.name);
         }
     }
