@@ -15,11 +15,18 @@ pub enum Mode {
     Bvh,
     /// SPEC §5 mode (b): the P-LIE's blocker lists.
     Lie,
+    /// Intel Embree 3 proposing candidates to the shared predicate (cargo feature `embree`).
+    #[cfg(feature = "embree")]
+    Embree,
 }
 
 impl Mode {
     /// Every mode, for tests that compare them all.
+    #[cfg(not(feature = "embree"))]
     pub const ALL: [Mode; 4] = [Mode::Brute, Mode::Octree, Mode::Bvh, Mode::Lie];
+    /// Every mode, for tests that compare them all.
+    #[cfg(feature = "embree")]
+    pub const ALL: [Mode; 5] = [Mode::Brute, Mode::Octree, Mode::Bvh, Mode::Lie, Mode::Embree];
 
     /// The name used on the command line.
     pub fn name(self) -> &'static str {
@@ -28,6 +35,8 @@ impl Mode {
             Mode::Octree => "octree",
             Mode::Bvh => "bvh",
             Mode::Lie => "lie",
+            #[cfg(feature = "embree")]
+            Mode::Embree => "embree",
         }
     }
 
