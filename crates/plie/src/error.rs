@@ -38,6 +38,10 @@ pub enum Error {
         /// The built-in names, comma-separated.
         known: String,
     },
+    /// The Embree device or scene could not be set up (feature `embree`).
+    #[cfg(feature = "embree")]
+    #[error("embree: {0}")]
+    Embree(String),
     /// Encoding an image failed.
     #[error("{}: cannot write image: {message}", path.display())]
     Image {

@@ -5,6 +5,8 @@
 
 pub mod brute;
 pub mod bvh;
+#[cfg(feature = "embree")]
+pub mod embree;
 pub mod lie;
 pub mod mode;
 pub mod octree;
@@ -12,6 +14,8 @@ pub mod query;
 
 pub use brute::Brute;
 pub use bvh::BvhVisibility;
+#[cfg(feature = "embree")]
+pub use embree::{Embree, EmbreeVisibility};
 pub use lie::LieVisibility;
 pub use mode::Mode;
 pub use octree::OctreeVisibility;
@@ -25,7 +29,8 @@ pub trait Visibility: Sync {
 }
 
 /// The visibility method for `mode`, over the structures already built. Fails if `mode` needs a
-/// P-LIE and none is given.
+/// P-LIE and none is given. [`Mode::Embree`] (feature `embree`) builds its own Embree scene here, owned
+/// by the returned box, and fails if Embree cannot be set up.
 pub fn for_mode<'a>(
     mode: Mode,
     scene: &'a crate::Scene,
@@ -44,5 +49,7 @@ pub fn for_mode<'a>(
                 _ => Box::new(LieVisibility::new(scene, octree, plie)),
             }
         }
+        #[cfg(feature = "embree")]
+        Mode::Embree => Box::new(EmbreeVisibility::new(scene)?),
     })
 }

@@ -17,11 +17,18 @@ pub enum Mode {
     Lie,
     /// Mode (b) with face grids: only the blockers of the cell where the ray crosses the face.
     Grid,
+    /// Intel Embree 3 proposing candidates to the shared predicate (cargo feature `embree`).
+    #[cfg(feature = "embree")]
+    Embree,
 }
 
 impl Mode {
     /// Every mode, for tests that compare them all.
+    #[cfg(not(feature = "embree"))]
     pub const ALL: [Mode; 5] = [Mode::Brute, Mode::Octree, Mode::Bvh, Mode::Lie, Mode::Grid];
+    /// Every mode, for tests that compare them all.
+    #[cfg(feature = "embree")]
+    pub const ALL: [Mode; 6] = [Mode::Brute, Mode::Octree, Mode::Bvh, Mode::Lie, Mode::Grid, Mode::Embree];
 
     /// The name used on the command line.
     pub fn name(self) -> &'static str {
@@ -31,6 +38,8 @@ impl Mode {
             Mode::Bvh => "bvh",
             Mode::Lie => "lie",
             Mode::Grid => "grid",
+            #[cfg(feature = "embree")]
+            Mode::Embree => "embree",
         }
     }
 
