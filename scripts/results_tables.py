@@ -38,6 +38,7 @@ def main():
     p.add_argument("--binary", default="target/release/plie")
     p.add_argument("--runs", type=int, default=5)
     p.add_argument("--shared", default="../shared")
+    p.add_argument("--modes", default="octree,bvh,lie,grid")
     a = p.parse_args()
     cons, shade = thesis(a.shared)
     scenes = [(s, t, []) for s, t in BUILTIN]
@@ -45,33 +46,37 @@ def main():
     plie_file = "/tmp/plie-results.plie"
 
     print("### Construction (blockers only, no regions)\n")
-    print("| scene | triangles | leaves | records | blockers/record (max) | build s | build + write s | load s | file bytes | thesis blockers-only s | thesis full s (leaves) |")
-    print("|---|---|---|---|---|---|---|---|---|---|---|")
-    total_build = 0.0
+    print("| scene | triangles | leaves | records | blockers/record (max) | build s | build + write s | load s | file bytes | build with grids s | thesis blockers-only s | thesis full s (leaves) |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|")
+    total_build = total_grid = 0.0
     for scene, tname, cam in scenes:
-        bs = [run(a.binary, ["build", "--scene", scene, "-o", plie_file, "--json"]) for _ in range(a.runs)]
+        bs = [run(a.binary, ["build", "--scene", scene, "-o", plie_file, "--json", "--no-grids"]) for _ in range(a.runs)]
+        gs = [run(a.binary, ["build", "--scene", scene, "-o", plie_file + ".g", "--json"]) for _ in range(a.runs)]
         b = bs[0]
         build = med(x["build_seconds"] for x in bs)
         write = med(x["build_seconds"] + x["write_seconds"] for x in bs)
         loads = [run(a.binary, ["render", "--scene", scene, "-o", "/tmp/plie-results.pfm", "--width", "1", "--height", "1",
-                                "--visibility", "lie", "--plie", plie_file, "--json", "--quiet"] + cam)["plie_load_seconds"]
+                                "--visibility", "lie", "--plie", plie_file, "--no-grids", "--json", "--quiet"] + cam)["plie_load_seconds"]
                  for _ in range(a.runs)]
+        grid_build = med(x["build_seconds"] for x in gs)
         total_build += build if not scene.endswith(".obj") else 0.0
+        total_grid += grid_build if not scene.endswith(".obj") else 0.0
         tb = cons.get((tname, "blockers_only"), (None, ""))[0]
         tf, tl = cons.get((tname, "full"), (None, ""))
         name = os.path.basename(scene)
         print(f"| {name} | {b['triangles']} | {b['leaves']} | {b['records']} | {b['blockers_mean']:.1f} ({b['blockers_max']}) "
-              f"| {build:.4f} | {write:.4f} | {med(loads):.4f} | {b['file_bytes']} | {tb} | {tf} ({tl}) |", flush=True)
-    print(f"\nTen built-in scenes, total build time: **{total_build:.3f} s** (thesis Table 8.4: 39.7 s without regions).\n")
+              f"| {build:.4f} | {write:.4f} | {med(loads):.4f} | {b['file_bytes']} | {grid_build:.4f} | {tb} | {tf} ({tl}) |", flush=True)
+    print(f"\nTen built-in scenes, total build time: **{total_build:.3f} s** without grids, **{total_grid:.3f} s** with face grids (thesis Table 8.4: 39.7 s without regions).\n")
 
+    modes = a.modes.split(",")
     print("### Shading (pass 2 only): 254x254 pixels, 1 eye ray each, 4 shadow rays per light\n")
-    print("| scene | triangles | octree s | bvh s | lie s | lie tests/ray | lie vs octree | thesis OCTREE s | thesis LIE s | thesis LIE vs OCTREE |")
-    print("|---|---|---|---|---|---|---|---|---|---|")
-    tot = {"octree": 0.0, "bvh": 0.0, "lie": 0.0}
+    print("| scene | triangles | " + " | ".join(f"{m} s" for m in modes) + " | grid tests/ray | thesis OCTREE s | thesis LIE s |")
+    print("|---|---|" + "---|" * len(modes) + "---|---|---|")
+    tot = {m: 0.0 for m in modes}
     ttot = {"OCTREE": 0.0, "LIE": 0.0}
     for scene, tname, cam in scenes:
         r = {}
-        for m in ["octree", "bvh", "lie"]:
+        for m in modes:
             rs = [run(a.binary, ["render", "--scene", scene, "-o", "/tmp/plie-results.pfm", "--width", "254", "--height", "254",
                                  "--eye-rays", "1", "--shadow-rays", "4", "--visibility", m, "--json", "--quiet"] + cam)
                   for _ in range(a.runs)]
@@ -84,14 +89,20 @@ def main():
         if builtin and to and tl:
             ttot["OCTREE"] += to
             ttot["LIE"] += tl
-        tcmp = f"{to / tl:.2f}x" if to and tl else ""
-        print(f"| {os.path.basename(scene)} | {r['lie'][1]['triangles']} | {r['octree'][0]:.4f} | {r['bvh'][0]:.4f} | {r['lie'][0]:.4f} "
-              f"| {r['lie'][1]['triangle_tests_per_shadow_ray']:.2f} | {r['octree'][0] / r['lie'][0]:.2f}x | {to} | {tl} | {tcmp} |", flush=True)
-    print(f"| **ten scenes** | | **{tot['octree']:.4f}** | **{tot['bvh']:.4f}** | **{tot['lie']:.4f}** | | "
-          f"**{tot['octree'] / tot['lie']:.2f}x** | **{ttot['OCTREE']:.2f}** | **{ttot['LIE']:.2f}** | **{ttot['OCTREE'] / ttot['LIE']:.2f}x** |")
-    print(f"\nWeighted speed-up of lie over octree, 1 - sum(t_lie)/sum(t_octree): **{100 * (1 - tot['lie'] / tot['octree']):.1f}%** "
-          f"(thesis, same setting: {100 * (1 - ttot['LIE'] / ttot['OCTREE']):.1f}%). "
-          f"bvh over octree: {100 * (1 - tot['bvh'] / tot['octree']):.1f}%; lie vs bvh: {tot['lie'] / tot['bvh']:.2f}x the bvh's time.")
+        tests = r["grid"][1]["triangle_tests_per_shadow_ray"] if "grid" in r else 0.0
+        print(f"| {os.path.basename(scene)} | {r[modes[0]][1]['triangles']} | " + " | ".join(f"{r[m][0]:.4f}" for m in modes)
+              + f" | {tests:.2f} | {to} | {tl} |", flush=True)
+    print("| **ten scenes** | | " + " | ".join(f"**{tot[m]:.4f}**" for m in modes) + f" | | **{ttot['OCTREE']:.2f}** | **{ttot['LIE']:.2f}** |")
+    print()
+    o = tot.get("octree")
+    for m in modes:
+        if m != "octree" and o:
+            print(f"- {m}: weighted speed-up over octree 1 - sum(t_{m})/sum(t_octree) = **{100 * (1 - tot[m] / o):.1f}%** ({o / tot[m]:.2f}x)")
+    print(f"- thesis, same setting (Table A.4, LIE over OCTREE): {100 * (1 - ttot['LIE'] / ttot['OCTREE']):.1f}% ({ttot['OCTREE'] / ttot['LIE']:.2f}x)")
+    if "bvh" in tot:
+        for m in modes:
+            if m != "bvh":
+                print(f"- {m} takes {tot[m] / tot['bvh']:.2f}x the bvh's time")
 
 if __name__ == "__main__":
     main()
