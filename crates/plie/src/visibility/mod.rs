@@ -21,6 +21,25 @@ pub use mode::Mode;
 pub use octree::OctreeVisibility;
 pub use query::{blocks, QueryCtx, QueryStats, ShadowRay};
 
+/// Test fixture shared by the modes' unit tests: a floor, a wall half above it, and a light above
+/// both. Returns the scene and the floor triangle.
+#[cfg(test)]
+pub(crate) fn wall_scene() -> (crate::Scene, crate::TriId) {
+    use glam::Vec3;
+    let mut b = crate::SceneBuilder::new("wall");
+    let m = b.diffuse("grey", Vec3::splat(0.5));
+    b.quad(
+        Vec3::new(-1.0, 0.0, -1.0),
+        Vec3::new(1.0, 0.0, -1.0),
+        Vec3::new(1.0, 0.0, 0.0),
+        Vec3::new(-1.0, 0.0, 0.0),
+        m,
+    );
+    let floor = b.triangle(Vec3::new(-2.0, -1.0, -2.0), Vec3::new(2.0, -1.0, 2.0), Vec3::new(2.0, -1.0, -2.0), m);
+    b.light("l", &[Vec3::new(-0.5, 1.0, -0.5), Vec3::new(-0.5, 1.0, 0.5), Vec3::new(0.5, 1.0, 0.5)], Vec3::ONE);
+    (b.build().expect("valid scene"), floor)
+}
+
 /// A visibility method: answers shadow-ray queries exactly.
 pub trait Visibility: Sync {
     /// True if some triangle other than the ray's own (its origin triangle and the target light's

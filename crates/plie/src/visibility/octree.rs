@@ -51,22 +51,11 @@ mod tests {
     use super::*;
     use crate::octree::OctreeParams;
     use crate::visibility::Brute;
-    use crate::{LightId, SceneBuilder, TriId};
+    use crate::{LightId, TriId};
 
     #[test]
     fn a_wall_blocks_and_a_gap_does_not() {
-        let mut b = SceneBuilder::new("wall");
-        let m = b.diffuse("grey", Vec3::splat(0.5));
-        b.quad(
-            Vec3::new(-1.0, 0.0, -1.0),
-            Vec3::new(1.0, 0.0, -1.0),
-            Vec3::new(1.0, 0.0, 0.0),
-            Vec3::new(-1.0, 0.0, 0.0),
-            m,
-        );
-        let floor = b.triangle(Vec3::new(-2.0, -1.0, -2.0), Vec3::new(2.0, -1.0, 2.0), Vec3::new(2.0, -1.0, -2.0), m);
-        b.light("l", &[Vec3::new(-0.5, 1.0, -0.5), Vec3::new(-0.5, 1.0, 0.5), Vec3::new(0.5, 1.0, 0.5)], Vec3::ONE);
-        let s = b.build().expect("valid scene");
+        let (s, floor) = crate::visibility::wall_scene();
         let o = Octree::build(&s, OctreeParams::default());
         let (oct, brute) = (OctreeVisibility::new(&s, &o), Brute::new(&s));
         let mut ctx = QueryCtx::new(s.triangle_count());

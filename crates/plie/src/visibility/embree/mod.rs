@@ -224,7 +224,7 @@ mod tests {
 
     use super::*;
     use crate::visibility::Brute;
-    use crate::{LightId, SceneBuilder};
+    use crate::LightId;
 
     /// splitmix64, for a fixed-seed random test.
     fn rng(state: &mut u64) -> f32 {
@@ -237,18 +237,7 @@ mod tests {
 
     #[test]
     fn a_wall_blocks_and_a_gap_does_not() {
-        let mut b = SceneBuilder::new("wall");
-        let m = b.diffuse("grey", Vec3::splat(0.5));
-        b.quad(
-            Vec3::new(-1.0, 0.0, -1.0),
-            Vec3::new(1.0, 0.0, -1.0),
-            Vec3::new(1.0, 0.0, 0.0),
-            Vec3::new(-1.0, 0.0, 0.0),
-            m,
-        );
-        let floor = b.triangle(Vec3::new(-2.0, -1.0, -2.0), Vec3::new(2.0, -1.0, 2.0), Vec3::new(2.0, -1.0, -2.0), m);
-        b.light("l", &[Vec3::new(-0.5, 1.0, -0.5), Vec3::new(-0.5, 1.0, 0.5), Vec3::new(0.5, 1.0, 0.5)], Vec3::ONE);
-        let s = b.build().expect("valid scene");
+        let (s, floor) = crate::visibility::wall_scene();
         let vis = EmbreeVisibility::new(&s).expect("Embree device");
         assert_eq!(vis.embree.triangle_count(), s.triangle_count());
         let mut ctx = QueryCtx::new(s.triangle_count());
