@@ -155,6 +155,8 @@ pub fn run(a: &Args) -> Result<()> {
             "occluded": s.occluded,
             "triangle_tests": s.triangle_tests,
             "triangle_tests_per_shadow_ray": per_ray,
+            "box_tests": s.box_tests,
+            "box_tests_per_shadow_ray": s.box_tests as f64 / s.shadow_rays.max(1) as f64,
             "shadow_rays_per_second": rays_per_second,
             "output": a.output.display().to_string(),
         });

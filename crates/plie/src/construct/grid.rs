@@ -45,8 +45,26 @@ pub fn cell_box(face: Dir, cell: &Aabb, g: u32, i: u32, j: u32) -> Aabb {
     Aabb::new(lo, hi)
 }
 
-/// The grid of one record: `g` and the `g * g` cell lists (cell `(i, j)` at `j * g + i`), or `None`
-/// when the record has too few blockers to need one.
+/// A record's face grid before flattening: the distinct lists, and for each cell (`(i, j)` at
+/// `j * g + i`) the index of its list. Cells of a square whose list barely shrinks share one list.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct PendingGrid {
+    /// Cells per side.
+    pub g: u32,
+    /// The distinct blocker lists.
+    pub lists: Vec<Vec<TriId>>,
+    /// List index of each cell.
+    pub cell_list: Vec<u32>,
+}
+
+/// A square is split into four only if the four lists together hold at most this many times the
+/// square's own list; otherwise its cells share its list. This skips splits that would barely
+/// shorten the lists and bounds a grid's memory at `SPLIT_GROWTH^levels` times the record's list.
+/// Measured (docs/results.md): 2.5 keeps most of the culling of unlimited splitting while the cell
+/// lists of cornell-bunny.obj hold 1.5x the record lists (4.0: 35x).
+const SPLIT_GROWTH: f64 = 2.5;
+
+/// The grid of one record, or `None` when the record has too few blockers to need one.
 pub fn face_grid(
     scene: &Scene,
     face: Dir,
@@ -54,15 +72,16 @@ pub fn face_grid(
     light: &Light,
     blockers: &[TriId],
     tol: f32,
-) -> Option<(u32, Vec<Vec<TriId>>)> {
+) -> Option<PendingGrid> {
     if blockers.len() < MIN_BLOCKERS {
         return None;
     }
     let g = resolution(blockers.len());
-    let mut cells = vec![Vec::new(); (g * g) as usize];
+    let mut out = PendingGrid { g, lists: Vec::new(), cell_list: vec![u32::MAX; (g * g) as usize] };
     let quad = Quad { scene, face, cell, light, tol, g };
-    quad.split(0, 0, g, blockers, &mut cells);
-    Some((g, cells))
+    quad.split(0, 0, g, blockers, &mut out);
+    debug_assert!(out.cell_list.iter().all(|&c| (c as usize) < out.lists.len()));
+    Some(out)
 }
 
 /// The quadtree walk that fills a grid: each square of cells filters its parent's list, so deep
@@ -93,15 +112,32 @@ impl Quad<'_> {
             .collect()
     }
 
-    /// Splits the square of `size` cells at `(i, j)` into four and recurses down to single cells.
-    fn split(&self, i: u32, j: u32, size: u32, list: &[TriId], cells: &mut [Vec<TriId>]) {
+    /// The square of `size` cells at `(i, j)` with blocker list `list`: split into four quarters
+    /// (recursing down to single cells) when that pays (see [`SPLIT_GROWTH`]), else one shared list.
+    fn split(&self, i: u32, j: u32, size: u32, list: &[TriId], out: &mut PendingGrid) {
         let half = size / 2;
-        for (di, dj) in [(0, 0), (half, 0), (0, half), (half, half)] {
-            let sub = self.filter(i + di, j + dj, half, list);
-            if half == 1 {
-                cells[((j + dj) * self.g + i + di) as usize] = sub;
-            } else if !sub.is_empty() {
-                self.split(i + di, j + dj, half, &sub, cells);
+        let quarters = [(0, 0), (half, 0), (0, half), (half, half)];
+        let subs: Vec<Vec<TriId>> = quarters.iter().map(|&(di, dj)| self.filter(i + di, j + dj, half, list)).collect();
+        if subs.iter().map(Vec::len).sum::<usize>() as f64 > SPLIT_GROWTH * list.len() as f64 {
+            self.share(i, j, size, list.to_vec(), out);
+            return;
+        }
+        for (&(di, dj), sub) in quarters.iter().zip(subs) {
+            if half > 1 && !sub.is_empty() {
+                self.split(i + di, j + dj, half, &sub, out);
+            } else {
+                self.share(i + di, j + dj, half, sub, out);
+            }
+        }
+    }
+
+    /// Gives every cell of the square of `size` cells at `(i, j)` the one list `list`.
+    fn share(&self, i: u32, j: u32, size: u32, list: Vec<TriId>, out: &mut PendingGrid) {
+        let id = out.lists.len() as u32;
+        out.lists.push(list);
+        for cj in j..j + size {
+            for ci in i..i + size {
+                out.cell_list[(cj * self.g + ci) as usize] = id;
             }
         }
     }

@@ -59,7 +59,7 @@ pub struct BuildStats {
 }
 
 /// One record before flattening: face, light, blockers and the optional face grid.
-type PendingRecord = (Dir, LightId, Vec<TriId>, Option<(u32, Vec<Vec<TriId>>)>);
+type PendingRecord = (Dir, LightId, Vec<TriId>, Option<grid::PendingGrid>);
 /// The records of one leaf before flattening.
 type LeafRecords = Vec<PendingRecord>;
 
@@ -102,13 +102,18 @@ pub fn build(scene: &Scene, octree: &Octree, params: PlieParams, progress: &dyn 
         stats.candidates_clipped += candidates;
         for (face, light, blockers, grid) in records {
             let mut fg = FaceGrid::default();
-            if let Some((res, cells)) = grid {
-                fg = FaceGrid { res, cells_start: plie.cells.len() as u32 };
+            if let Some(pg) = grid {
+                fg = FaceGrid { res: pg.g, cells_start: plie.cells.len() as u32 };
                 stats.grids += 1;
-                for c in cells {
-                    stats.grid_cells_lit += c.is_empty() as usize;
-                    plie.cells.push((plie.cell_blockers.len() as u32, c.len() as u32));
-                    plie.cell_blockers.extend(c);
+                let mut ranges = Vec::with_capacity(pg.lists.len());
+                for l in pg.lists {
+                    ranges.push((plie.cell_blockers.len() as u32, l.len() as u32));
+                    plie.cell_blockers.extend(l);
+                }
+                for c in pg.cell_list {
+                    let r = ranges[c as usize];
+                    stats.grid_cells_lit += (r.1 == 0) as usize;
+                    plie.cells.push(r);
                 }
             }
             plie.grids.push(fg);

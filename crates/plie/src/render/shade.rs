@@ -121,6 +121,7 @@ pub fn shade(
                 delta.shadow_rays -= before.shadow_rays;
                 delta.occluded -= before.occluded;
                 delta.triangle_tests -= before.triangle_tests;
+                delta.box_tests -= before.box_tests;
                 delta
             },
         )

@@ -41,6 +41,7 @@ impl<'a> LieVisibility<'a> {
     /// The box cull, then the shared predicate.
     #[inline]
     fn test(&self, seg: &Segment, ray: &ShadowRay, t: TriId, ctx: &mut QueryCtx) -> bool {
+        ctx.stats.box_tests += 1;
         seg.clip(&self.tri_boxes[t.idx()]).is_some() && blocks(self.scene, ray, t, ctx)
     }
 }

@@ -51,6 +51,8 @@ pub struct QueryStats {
     pub occluded: u64,
     /// Watertight triangle tests run.
     pub triangle_tests: u64,
+    /// Candidate bounding-box tests run before triangle tests (P-LIE modes).
+    pub box_tests: u64,
 }
 
 impl std::ops::AddAssign for QueryStats {
@@ -58,6 +60,7 @@ impl std::ops::AddAssign for QueryStats {
         self.shadow_rays += o.shadow_rays;
         self.occluded += o.occluded;
         self.triangle_tests += o.triangle_tests;
+        self.box_tests += o.box_tests;
     }
 }
 
