@@ -98,7 +98,9 @@ pub fn run(a: &Args) -> Result<()> {
     let bvh = Bvh::build(&scene);
     let bvh_seconds = t.elapsed().as_secs_f64();
     let bar = Bar::new(a.quiet || a.json);
-    let params = PlieParams { max_triangles: a.max_triangles, max_depth: a.max_depth, grids: !a.no_grids };
+    // Face grids only serve mode `grid`: other modes skip building them.
+    let grids = !a.no_grids && a.visibility == Mode::Grid;
+    let params = PlieParams { max_triangles: a.max_triangles, max_depth: a.max_depth, grids };
     params.octree().validate()?;
     let t = Instant::now();
     let (octree, plie, plie_seconds, load_plie_seconds) = match (&a.plie, a.visibility.needs_plie()) {

@@ -113,8 +113,9 @@ pub fn save_plie(path: &Path, scene: &Scene, octree: &Octree, plie: &Plie) -> Re
 }
 
 /// Loads a `.plie` file for `scene`: checks format, version, integrity, that it was built for this
-/// scene (and, if `expect` is given, with these parameters), rebuilds the octree and checks that it is
-/// the one the P-LIE was built on. Returns the octree and the P-LIE.
+/// scene (and, if `expect` is given, on the same octree parameters; whether it has face grids does
+/// not matter, modes use them when present), rebuilds the octree and checks that it is the one the
+/// P-LIE was built on. Returns the octree and the P-LIE.
 pub fn load_plie(path: &Path, scene: &Scene, expect: Option<PlieParams>) -> Result<(Octree, Plie)> {
     let bytes = std::fs::read(path).map_err(|source| Error::Io { path: path.to_path_buf(), source })?;
     let bad = |m: String| Error::Parse { path: path.to_path_buf(), line: None, message: m };
@@ -148,7 +149,7 @@ pub fn load_plie(path: &Path, scene: &Scene, expect: Option<PlieParams>) -> Resu
         return Err(bad(format!("was built for another scene, not '{}' (rebuild it with `plie build`)", scene.name)));
     }
     if let Some(p) = expect {
-        if p != body.params {
+        if p.octree() != body.params.octree() {
             return Err(bad(format!("was built with other parameters ({:?}) than asked for ({p:?})", body.params)));
         }
     }
