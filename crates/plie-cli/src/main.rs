@@ -2,6 +2,9 @@
 //! One file per subcommand; errors get context here and end the process with a one-line message and
 //! exit code 1 (clap's usage errors exit with 2).
 
+mod bench;
+mod bench_chart;
+mod bench_report;
 mod build;
 mod progress;
 mod render;
@@ -26,6 +29,8 @@ enum Command {
     Render(Box<render::Args>),
     /// Build the P-LIE of a scene and save it (.plie).
     Build(Box<build::Args>),
+    /// Measure construction, shading and throughput per scene and mode (the thesis' protocol).
+    Bench(Box<bench::Args>),
 }
 
 fn main() {
@@ -34,6 +39,7 @@ fn main() {
         Command::Scenes(a) => scenes::run(&a),
         Command::Render(a) => render::run(&a),
         Command::Build(a) => build::run(&a),
+        Command::Bench(a) => bench::run(&a),
     };
     if let Err(e) = result {
         eprintln!("error: {}", one_line(&e));

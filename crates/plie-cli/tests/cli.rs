@@ -264,3 +264,52 @@ fn existing_output_is_kept_when_rendering_fails() {
     assert!(!o.status.success());
     assert_eq!(std::fs::read_to_string(&out).unwrap(), "precious");
 }
+
+#[test]
+fn bench_quick_writes_report_csv_json_and_chart() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("bench");
+    let o = plie(&["bench", "--quick", "--quiet", "--out", out.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let read = |name: &str| std::fs::read_to_string(out.join(name)).unwrap_or_else(|e| panic!("{name}: {e}"));
+    let scenes = ["cornell-cube-1", "cornell-cube-3"];
+    let modes: Vec<&str> = ["octree", "bvh", "lie", "grid"].into();
+
+    let json: serde_json::Value = serde_json::from_str(&read("results.json")).expect("results.json parses");
+    let names: Vec<&str> = json["scenes"].as_array().unwrap().iter().map(|s| s["name"].as_str().unwrap()).collect();
+    assert_eq!(names, scenes);
+
+    let csv = read("results.csv");
+    let mut lines = csv.lines();
+    let header: Vec<&str> = lines.next().expect("a header").split(',').collect();
+    let (scene_col, mode_col) = (1, 3);
+    assert_eq!((header[scene_col], header[mode_col]), ("scene", "mode"));
+    let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
+    assert!(rows.iter().all(|r| r.len() == header.len()), "ragged CSV:\n{csv}");
+    for s in scenes {
+        for m in &modes {
+            assert!(
+                rows.iter().any(|r| r[0] == "shading" && r[scene_col] == s && r[mode_col] == *m),
+                "no {s}/{m} row:\n{csv}"
+            );
+        }
+    }
+
+    let report = read("report.md");
+    for heading in [
+        "# plie bench",
+        "## Construction",
+        "## Shading",
+        "## Weighted speed-ups",
+        "## Break-even",
+        "## Shadow-ray throughput",
+    ] {
+        assert!(report.contains(heading), "report lacks '{heading}':\n{report}");
+    }
+    for s in scenes {
+        assert!(report.contains(s), "report lacks {s}");
+    }
+    let svg = read("shading.svg");
+    assert!(svg.trim_start().starts_with("<svg") && svg.trim_end().ends_with("</svg>"), "not an SVG");
+    assert!(scenes.iter().all(|s| svg.contains(s)), "chart lacks the scene names");
+}

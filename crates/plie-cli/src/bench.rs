@@ -1,0 +1,347 @@
+//! `plie bench`: the thesis' measurement protocol (SPEC §7, Chapter 8) run in-process. For each scene:
+//! P-LIE construction with the thesis' test-1 parameters and with face grids; shading time of the
+//! hit buffer (pass 2 alone) for every visibility mode but brute, at the thesis' image settings;
+//! shadow-ray throughput with one thread and with all; and the break-even number of images. The
+//! files are written by [`crate::bench_report`].
+//!
+//! Refinement (the thesis' test 2) and umbra/penumbra regions (modes c and d) do not exist yet, so
+//! they are not measured.
+
+use std::path::PathBuf;
+use std::time::Instant;
+
+use anyhow::{Context, Result};
+use plie::lie::{Plie, PlieParams};
+use plie::octree::Octree;
+use plie::render::shade::shade;
+use plie::render::{HitBuffer, NoProgress, Progress};
+use plie::scene::builtin;
+use plie::visibility::bvh::Bvh;
+use plie::visibility::{self, Mode};
+use plie::{Camera, Scene};
+use serde::Serialize;
+
+use crate::progress::Bar;
+use crate::scene_arg::SceneArgs;
+
+/// Options of `plie bench`.
+#[derive(clap::Args)]
+pub struct Args {
+    /// A short run: 1 run, cornell-cube-1 and cornell-cube-3, 32x32 eye rays, 4 shadow rays per light.
+    #[arg(long)]
+    quick: bool,
+    /// Scenes to measure: built-in names or scene files (default: the ten built-in scenes).
+    #[arg(long, value_name = "A,B,...", value_delimiter = ',')]
+    scenes: Vec<String>,
+    /// Directory for report.md, results.csv, results.json and shading.svg (created if missing).
+    #[arg(long, default_value = "bench-out", value_name = "DIR")]
+    out: PathBuf,
+    /// Runs per measurement; the median is reported (default 5, 1 with --quick).
+    #[arg(long, value_name = "N")]
+    runs: Option<usize>,
+    /// Worker threads for the all-threads figures (default: all cores).
+    #[arg(long, value_name = "T")]
+    threads: Option<usize>,
+    /// Directory of the thesis' figures (construction.tsv, shading-times.tsv).
+    #[arg(long, default_value = "../shared/thesis", value_name = "DIR")]
+    thesis: PathBuf,
+    /// No progress bar.
+    #[arg(long, short)]
+    quiet: bool,
+}
+
+/// What is measured: scenes, image settings, runs.
+pub struct Plan {
+    pub scenes: Vec<String>,
+    /// Image sizes (width = height), 1 eye ray per pixel.
+    pub sizes: Vec<u32>,
+    /// Shadow rays per light.
+    pub shadow_rays: Vec<u32>,
+    pub runs: usize,
+    pub modes: Vec<Mode>,
+}
+
+impl Plan {
+    fn new(a: &Args) -> Result<Plan> {
+        let runs = a.runs.unwrap_or(if a.quick { 1 } else { 5 });
+        anyhow::ensure!(runs >= 1, "--runs must be at least 1");
+        let scenes = match (a.scenes.is_empty(), a.quick) {
+            (false, _) => a.scenes.clone(),
+            (true, true) => vec!["cornell-cube-1".into(), "cornell-cube-3".into()],
+            (true, false) => builtin::NAMES.iter().map(|s| s.to_string()).collect(),
+        };
+        let (sizes, shadow_rays) = if a.quick { (vec![32], vec![4]) } else { (vec![126, 254], vec![4, 9]) };
+        let modes = Mode::ALL.into_iter().filter(|m| *m != Mode::Brute).collect();
+        Ok(Plan { scenes, sizes, shadow_rays, runs, modes })
+    }
+
+    /// The setting of the break-even figures: the largest image with the fewest shadow rays (254/4).
+    pub fn break_even_setting(&self) -> (u32, u32) {
+        (*self.sizes.iter().max().expect("a size"), *self.shadow_rays.iter().min().expect("a count"))
+    }
+
+    /// The setting of the single-threaded throughput: the smallest image, fewest shadow rays.
+    pub fn throughput_setting(&self) -> (u32, u32) {
+        (*self.sizes.iter().min().expect("a size"), *self.shadow_rays.iter().min().expect("a count"))
+    }
+
+    fn steps_per_scene(&self) -> u64 {
+        let m = self.modes.len() as u64;
+        1 + m * (self.sizes.len() * self.shadow_rays.len()) as u64 + m
+    }
+}
+
+/// Everything measured; serialised as results.json.
+#[derive(Serialize)]
+pub struct Results {
+    pub command: String,
+    pub date: String,
+    pub cores: usize,
+    pub cpu: Option<String>,
+    pub threads: usize,
+    pub runs: usize,
+    pub quick: bool,
+    pub break_even_setting: (u32, u32),
+    pub throughput_setting: (u32, u32),
+    pub scenes: Vec<SceneResult>,
+}
+
+/// The figures of one scene.
+#[derive(Serialize)]
+pub struct SceneResult {
+    pub name: String,
+    pub triangles: usize,
+    pub lights: usize,
+    pub bvh_seconds: f64,
+    pub octree_seconds: f64,
+    pub builds: Vec<BuildResult>,
+    /// All-threads rows for every setting, then 1-thread rows at the throughput setting.
+    pub shading: Vec<Shading>,
+    pub break_even: Vec<BreakEven>,
+}
+
+/// One P-LIE construction (median seconds of the construction alone, octree excluded).
+#[derive(Serialize)]
+pub struct BuildResult {
+    /// "thesis" (`PlieParams::thesis()`) or "grids" (`PlieParams::default()`).
+    pub config: &'static str,
+    pub seconds: f64,
+    pub leaves: usize,
+    pub records: usize,
+    pub blockers_mean: f64,
+    pub blockers_max: u32,
+}
+
+/// The shading pass of one mode at one setting (median seconds).
+#[derive(Serialize)]
+pub struct Shading {
+    pub mode: Mode,
+    pub size: u32,
+    pub shadow_rays: u32,
+    pub threads: usize,
+    pub seconds: f64,
+    pub rays: u64,
+    pub triangle_tests_per_ray: f64,
+    pub mrays_per_second: f64,
+    pub mrays_per_second_per_core: f64,
+}
+
+/// Images after which `mode` (build + shading) beats `against` (build + shading); None: never.
+#[derive(Serialize)]
+pub struct BreakEven {
+    pub mode: Mode,
+    pub against: Mode,
+    pub images: Option<u64>,
+}
+
+pub fn run(a: &Args) -> Result<()> {
+    crate::scenes::set_threads(a.threads)?;
+    let plan = Plan::new(a)?;
+    std::fs::create_dir_all(&a.out).with_context(|| format!("cannot create directory {}", a.out.display()))?;
+    let one = rayon::ThreadPoolBuilder::new().num_threads(1).build()?;
+    let bar = Bar::new(a.quiet);
+    bar.start("bench", plan.steps_per_scene() * plan.scenes.len() as u64);
+    let mut scenes = Vec::new();
+    for name in &plan.scenes {
+        scenes.push(bench_scene(name, &plan, &one, &bar).with_context(|| format!("scene {name}"))?);
+    }
+    bar.finish();
+    let results = Results {
+        command: std::env::args().collect::<Vec<_>>().join(" "),
+        date: crate::bench_report::utc_now(),
+        cores: std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1),
+        cpu: crate::bench_report::cpu_model(),
+        threads: rayon::current_num_threads(),
+        runs: plan.runs,
+        quick: a.quick,
+        break_even_setting: plan.break_even_setting(),
+        throughput_setting: plan.throughput_setting(),
+        scenes,
+    };
+    crate::bench_report::write_all(&a.out, &a.thesis, &plan, &results)?;
+    if !a.quiet {
+        eprintln!("wrote {}/{{report.md, results.csv, results.json, shading.svg}}", a.out.display());
+    }
+    Ok(())
+}
+
+/// Loads a built-in scene or a scene file, with its camera (or a framing default).
+fn load(name: &str) -> Result<(Scene, Camera)> {
+    let args = SceneArgs { scene: name.to_string(), eye: None, target: None, up: None, fov: None };
+    let scene = args.load()?;
+    let camera = args.camera(&scene)?;
+    Ok((scene, camera))
+}
+
+/// Runs `f` `runs` times; the last result and the median seconds.
+fn timed<T>(runs: usize, mut f: impl FnMut() -> T) -> (T, f64) {
+    let mut times = Vec::with_capacity(runs);
+    let mut last = None;
+    for _ in 0..runs {
+        let t = Instant::now();
+        last = Some(f());
+        times.push(t.elapsed().as_secs_f64());
+    }
+    (last.expect("at least one run"), median(&mut times))
+}
+
+pub fn median(xs: &mut [f64]) -> f64 {
+    xs.sort_by(f64::total_cmp);
+    let n = xs.len();
+    if n % 2 == 1 {
+        xs[n / 2]
+    } else {
+        0.5 * (xs[n / 2 - 1] + xs[n / 2])
+    }
+}
+
+fn build_plie(
+    scene: &Scene,
+    octree: &Octree,
+    params: PlieParams,
+    config: &'static str,
+    runs: usize,
+) -> (Plie, BuildResult) {
+    let ((plie, s), seconds) = timed(runs, || plie::construct::build(scene, octree, params, &NoProgress));
+    let r = BuildResult {
+        config,
+        seconds,
+        leaves: s.leaves,
+        records: s.records,
+        blockers_mean: s.blockers_mean,
+        blockers_max: s.blockers_max,
+    };
+    (plie, r)
+}
+
+fn bench_scene(name: &str, plan: &Plan, one: &rayon::ThreadPool, bar: &Bar) -> Result<SceneResult> {
+    let (scene, camera) = load(name)?;
+    let (bvh, bvh_seconds) = timed(plan.runs, || Bvh::build(&scene));
+    let thesis = PlieParams::thesis();
+    thesis.octree().validate()?;
+    let (octree, octree_seconds) = timed(plan.runs, || Octree::build(&scene, thesis.octree()));
+    let (lie, b1) = build_plie(&scene, &octree, thesis, "thesis", plan.runs);
+    let (grid, b2) = build_plie(&scene, &octree, PlieParams::default(), "grids", plan.runs);
+    bar.advance(1);
+    let s = Structures { scene: &scene, bvh: &bvh, octree: &octree, lie: &lie, grid: &grid };
+    let mut shading = Vec::new();
+    let mut single = Vec::new();
+    for &size in &plan.sizes {
+        let hits = HitBuffer::build(&scene, &camera, (size, size, 1), &bvh, Some(&octree));
+        for &mode in &plan.modes {
+            let vis = s.visibility(mode)?;
+            for &n in &plan.shadow_rays {
+                shading.push(time_shading(&scene, &hits, vis.as_ref(), (mode, size, n), plan.runs));
+                bar.advance(1);
+                if (size, n) == plan.throughput_setting() {
+                    single.push(one.install(|| time_shading(&scene, &hits, vis.as_ref(), (mode, size, n), plan.runs)));
+                    bar.advance(1);
+                }
+            }
+        }
+    }
+    let break_even = break_even(plan, &shading, (octree_seconds, bvh_seconds), (b1.seconds, b2.seconds));
+    shading.extend(single);
+    Ok(SceneResult {
+        name: scene.name.clone(),
+        triangles: scene.triangle_count(),
+        lights: scene.lights.len(),
+        bvh_seconds,
+        octree_seconds,
+        builds: vec![b1, b2],
+        shading,
+        break_even,
+    })
+}
+
+/// The structures of one scene, from which every mode's visibility is made.
+struct Structures<'a> {
+    scene: &'a Scene,
+    bvh: &'a Bvh,
+    octree: &'a Octree,
+    /// Built with the thesis' parameters (mode lie).
+    lie: &'a Plie,
+    /// Built with face grids (mode grid).
+    grid: &'a Plie,
+}
+
+impl<'a> Structures<'a> {
+    fn visibility(&self, mode: Mode) -> Result<Box<dyn visibility::Visibility + 'a>> {
+        let plie = if mode == Mode::Grid { self.grid } else { self.lie };
+        Ok(visibility::for_mode(mode, self.scene, self.bvh, self.octree, Some(plie))?)
+    }
+}
+
+fn time_shading(
+    scene: &Scene,
+    hits: &HitBuffer,
+    vis: &dyn visibility::Visibility,
+    (mode, size, n): (Mode, u32, u32),
+    runs: usize,
+) -> Shading {
+    let ((_, stats), seconds) = timed(runs, || shade(scene, hits, vis, n, 0, &NoProgress));
+    let threads = rayon::current_num_threads();
+    let mrays = stats.shadow_rays as f64 / seconds.max(1e-9) / 1e6;
+    Shading {
+        mode,
+        size,
+        shadow_rays: n,
+        threads,
+        seconds,
+        rays: stats.shadow_rays,
+        triangle_tests_per_ray: stats.triangle_tests as f64 / stats.shadow_rays.max(1) as f64,
+        mrays_per_second: mrays,
+        mrays_per_second_per_core: mrays / threads as f64,
+    }
+}
+
+/// Break-even at the plan's break-even setting for lie and grid against octree and bvh. Costs: octree
+/// mode = octree build; bvh = BVH build; lie/grid = octree build + P-LIE build (thesis / with grids).
+fn break_even(
+    plan: &Plan,
+    shading: &[Shading],
+    (octree_s, bvh_s): (f64, f64),
+    (lie_s, grid_s): (f64, f64),
+) -> Vec<BreakEven> {
+    let (size, n) = plan.break_even_setting();
+    let t = |m: Mode| shading.iter().find(|r| r.mode == m && r.size == size && r.shadow_rays == n).map(|r| r.seconds);
+    let mut out = Vec::new();
+    for (mode, build) in [(Mode::Lie, octree_s + lie_s), (Mode::Grid, octree_s + grid_s)] {
+        for (against, other_build) in [(Mode::Octree, octree_s), (Mode::Bvh, bvh_s)] {
+            let (Some(tm), Some(ta)) = (t(mode), t(against)) else { continue };
+            out.push(BreakEven { mode, against, images: images_to_break_even(build, tm, other_build, ta) });
+        }
+    }
+    out
+}
+
+/// Smallest number of images `k` with `build + k * t <= other_build + k * other_t`; None if never.
+pub fn images_to_break_even(build: f64, t: f64, other_build: f64, other_t: f64) -> Option<u64> {
+    if build <= other_build && t <= other_t {
+        return Some(0);
+    }
+    if t >= other_t {
+        return None;
+    }
+    Some(((build - other_build) / (other_t - t)).ceil().max(0.0) as u64)
+}
