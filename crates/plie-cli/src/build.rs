@@ -5,10 +5,10 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use anyhow::{Context, Result};
-use plie::lie::PlieParams;
-use plie::octree::{Octree, OctreeParams};
+use plie::octree::Octree;
 use serde_json::json;
 
+use crate::plie_args::PlieArgs;
 use crate::progress::Bar;
 use crate::scene_arg::SceneArgs;
 
@@ -20,15 +20,8 @@ pub struct Args {
     /// Output file (.plie).
     #[arg(short = 'o', long = "output", value_name = "OUT.plie")]
     output: PathBuf,
-    /// Octree: split leaves holding more triangles than this.
-    #[arg(long, default_value_t = 200, value_name = "N")]
-    max_triangles: usize,
-    /// P-LIE: skip the face grids (per-cell blocker lists used by `--visibility grid`).
-    #[arg(long)]
-    no_grids: bool,
-    /// Octree: maximum depth.
-    #[arg(long, default_value_t = OctreeParams::default().max_depth, value_name = "D")]
-    max_depth: u32,
+    #[command(flatten)]
+    params: PlieArgs,
     /// Worker threads (default: all cores). The result does not depend on it.
     #[arg(long, value_name = "T")]
     threads: Option<usize>,
@@ -43,8 +36,7 @@ pub struct Args {
 pub fn run(a: &Args) -> Result<()> {
     crate::scenes::set_threads(a.threads)?;
     let scene = a.scene.load()?;
-    let params = PlieParams { max_triangles: a.max_triangles, max_depth: a.max_depth, grids: !a.no_grids };
-    params.octree().validate()?;
+    let params = a.params.params(true)?;
     let bar = Bar::new(a.quiet || a.json);
     let t_all = Instant::now();
     let t = Instant::now();
@@ -63,8 +55,8 @@ pub fn run(a: &Args) -> Result<()> {
             "scene": scene.name,
             "triangles": scene.triangle_count(),
             "lights": scene.lights.len(),
-            "max_triangles": a.max_triangles,
-            "max_depth": a.max_depth,
+            "max_triangles": params.max_triangles,
+            "max_depth": params.max_depth,
             "threads": rayon::current_num_threads(),
             "build_seconds": build_seconds,
             "octree_seconds": octree_seconds,
@@ -108,7 +100,7 @@ pub fn run(a: &Args) -> Result<()> {
             stats.candidates_clipped,
             stats.blockers_seconds
         );
-        if a.no_grids {
+        if !params.grids {
             println!("face grids      none (--no-grids)");
         } else {
             println!(

@@ -6,6 +6,7 @@ mod bench;
 mod bench_chart;
 mod bench_report;
 mod build;
+mod plie_args;
 mod progress;
 mod render;
 mod scene_arg;

@@ -5,14 +5,14 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use anyhow::{Context, Result};
-use plie::lie::PlieParams;
-use plie::octree::{Octree, OctreeParams};
+use plie::octree::Octree;
 
 use plie::render::{render, RenderSettings};
 use plie::visibility::bvh::Bvh;
 use plie::visibility::{self, Mode};
 use serde_json::json;
 
+use crate::plie_args::PlieArgs;
 use crate::progress::Bar;
 use crate::scene_arg::SceneArgs;
 
@@ -46,15 +46,8 @@ pub struct Args {
     /// Worker threads (default: all cores). Images do not depend on it.
     #[arg(long, value_name = "T")]
     threads: Option<usize>,
-    /// Octree: split leaves holding more triangles than this.
-    #[arg(long, default_value_t = 200, value_name = "N")]
-    max_triangles: usize,
-    /// P-LIE: skip the face grids (per-cell blocker lists used by `--visibility grid`).
-    #[arg(long)]
-    no_grids: bool,
-    /// Octree: maximum depth.
-    #[arg(long, default_value_t = OctreeParams::default().max_depth, value_name = "D")]
-    max_depth: u32,
+    #[command(flatten)]
+    params: PlieArgs,
     /// Use this P-LIE file (from `plie build`) instead of building one (modes that need a P-LIE).
     #[arg(long, value_name = "FILE.plie")]
     plie: Option<PathBuf>,
@@ -99,9 +92,7 @@ pub fn run(a: &Args) -> Result<()> {
     let bvh_seconds = t.elapsed().as_secs_f64();
     let bar = Bar::new(a.quiet || a.json);
     // Face grids only serve mode `grid`: other modes skip building them.
-    let grids = !a.no_grids && a.visibility == Mode::Grid;
-    let params = PlieParams { max_triangles: a.max_triangles, max_depth: a.max_depth, grids };
-    params.octree().validate()?;
+    let params = a.params.params(a.visibility == Mode::Grid)?;
     let t = Instant::now();
     let (octree, plie, plie_seconds, load_plie_seconds) = match (&a.plie, a.visibility.needs_plie()) {
         (Some(path), true) => {
