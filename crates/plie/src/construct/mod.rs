@@ -117,7 +117,7 @@ pub fn build(scene: &Scene, octree: &Octree, params: PlieParams, progress: &dyn 
                 }
             }
             plie.grids.push(fg);
-            let i = (l * 6 + face.index()) * lights + light.idx();
+            let i = plie.slot(LeafId(l as u32), face, light);
             plie.record_index[i] = plie.records.len() as u32;
             plie.records.push(Record {
                 leaf: LeafId(l as u32),

@@ -181,7 +181,7 @@ fn check_structure(p: &Plie, scene: &Scene, octree: &Octree) -> std::result::Res
             continue;
         }
         let rec = p.records.get(r as usize).ok_or_else(|| format!("record index {r} out of range"))?;
-        let at = (rec.leaf.idx() * 6 + rec.face.index()) * p.lights as usize + rec.light.idx();
+        let at = p.slot(rec.leaf, rec.face, rec.light);
         if at != i {
             return Err(format!("record {r} is filed under the wrong (leaf, face, light)"));
         }

@@ -93,21 +93,22 @@ pub struct Plie {
 }
 
 impl Plie {
+    /// The slot of (leaf, face, light) in [`Plie::record_index`].
+    #[inline]
+    pub fn slot(&self, leaf: LeafId, face: Dir, light: LightId) -> usize {
+        (leaf.idx() * 6 + face.index()) * self.lights as usize + light.idx()
+    }
+
     /// The record of (leaf, face, light), if the face sees the light.
     #[inline]
     pub fn record(&self, leaf: LeafId, face: Dir, light: LightId) -> Option<&Record> {
-        let i = (leaf.idx() * 6 + face.index()) * self.lights as usize + light.idx();
-        match self.record_index[i] {
-            NO_RECORD => None,
-            r => Some(&self.records[r as usize]),
-        }
+        self.record_id(leaf, face, light).map(|r| &self.records[r])
     }
 
     /// The index of the record of (leaf, face, light) in [`Plie::records`], if any.
     #[inline]
     pub fn record_id(&self, leaf: LeafId, face: Dir, light: LightId) -> Option<usize> {
-        let i = (leaf.idx() * 6 + face.index()) * self.lights as usize + light.idx();
-        match self.record_index[i] {
+        match self.record_index[self.slot(leaf, face, light)] {
             NO_RECORD => None,
             r => Some(r as usize),
         }
