@@ -71,9 +71,19 @@ pub fn run(a: &Args) -> Result<()> {
             "blockers_total": stats.blockers_total,
             "blockers_mean": stats.blockers_mean,
             "blockers_max": stats.blockers_max,
+            "regions": params.regions,
+            "records_removed_umbra": stats.records_removed_umbra,
+            "records_with_umbra": stats.records_with_umbra,
+            "records_with_penumbra": stats.records_with_penumbra,
+            "region_polygon_vertices": stats.region_polygon_vertices,
+            "region_triangles": stats.region_triangles,
+            "region_bytes": stats.region_bytes,
+            "umbra_fraction_mean": stats.umbra_fraction_mean,
+            "penumbra_fraction_mean": stats.penumbra_fraction_mean,
             "grids": stats.grids,
             "grid_cells": plie.cells.len(),
             "grid_cells_lit": stats.grid_cells_lit,
+            "grid_cells_umbra": stats.grid_cells_umbra,
             "grid_blockers_total": plie.cell_blockers.len(),
             "bytes": memory,
             "file_bytes": file_bytes,
@@ -100,14 +110,31 @@ pub fn run(a: &Args) -> Result<()> {
             stats.candidates_clipped,
             stats.blockers_seconds
         );
+        if !params.regions {
+            println!("regions         none (--no-regions)");
+        } else {
+            println!(
+                "regions         {} records removed (fully in umbra); of those kept, {} with umbra, {} with penumbra",
+                stats.records_removed_umbra, stats.records_with_umbra, stats.records_with_penumbra
+            );
+            println!(
+                "                mean umbra {:.1}% and penumbra {:.1}% of a face; {} polygon vertices, {} triangles ({} bytes)",
+                100.0 * stats.umbra_fraction_mean,
+                100.0 * stats.penumbra_fraction_mean,
+                stats.region_polygon_vertices,
+                stats.region_triangles,
+                stats.region_bytes
+            );
+        }
         if !params.grids {
             println!("face grids      none (--no-grids)");
         } else {
             println!(
-                "face grids      {} records with a grid, {} cells ({} fully lit), {} cell blocker references",
+                "face grids      {} records with a grid, {} cells ({} fully lit, {} umbra), {} cell blocker references",
                 stats.grids,
                 plie.cells.len(),
                 stats.grid_cells_lit,
+                stats.grid_cells_umbra,
                 plie.cell_blockers.len()
             );
         }

@@ -1,5 +1,5 @@
-//! `--max-triangles`, `--max-depth` and `--no-grids`: the P-LIE build parameters (SPEC §4.9) shared
-//! by `plie build` and `plie render`.
+//! `--max-triangles`, `--max-depth`, `--no-grids` and `--no-regions`: the P-LIE build parameters
+//! (SPEC §4.9) shared by `plie build` and `plie render`.
 
 use anyhow::Result;
 use plie::lie::PlieParams;
@@ -17,6 +17,10 @@ pub struct PlieArgs {
     /// P-LIE: skip the face grids (per-cell blocker lists used by `--visibility grid`).
     #[arg(long)]
     pub no_grids: bool,
+    /// P-LIE: skip umbra and penumbra (SPEC §4.5) and the removal of fully dark records (§4.6), as
+    /// in the thesis' Table 8.4. Modes `umbra` and `penumbra` need them.
+    #[arg(long)]
+    pub no_regions: bool,
 }
 
 impl PlieArgs {
@@ -26,6 +30,7 @@ impl PlieArgs {
             max_triangles: self.max_triangles,
             max_depth: self.max_depth,
             grids: want_grids && !self.no_grids,
+            regions: !self.no_regions,
         };
         p.octree().validate()?;
         Ok(p)

@@ -11,7 +11,11 @@ use plie::geometry::RayTest;
 use plie::lie::PlieParams;
 use plie::octree::{Dir, LeafId, Octree};
 use plie::render::NoProgress;
+use plie::visibility::Mode;
 use plie::{LightId, Scene, SceneBuilder};
+
+/// The modes answered from the P-LIE.
+const PLIE_MODES: [Mode; 4] = [Mode::Lie, Mode::Umbra, Mode::Penumbra, Mode::Grid];
 
 /// splitmix64 in [0, 1).
 struct Rng(u64);
@@ -98,8 +102,9 @@ fn blockers_contain_every_triangle_between_face_and_light() {
 
 #[test]
 fn faces_without_a_record_receive_no_light() {
+    // Without regions, so that no record is removed for being dark (tests/regions.rs checks those).
     let scene = room();
-    let params = PlieParams { max_triangles: 8, ..PlieParams::thesis() };
+    let params = PlieParams { max_triangles: 8, regions: false, ..PlieParams::thesis() };
     let octree = Octree::build(&scene, params.octree());
     let (plie, _) = plie::construct::build(&scene, &octree, params, &NoProgress);
     let light = &scene.lights[0];
@@ -161,19 +166,20 @@ fn lie_mode_matches_brute_force_in_the_room() {
         let octree = Octree::build(&scene, params.octree());
         let (plie, stats) = plie::construct::build(&scene, &octree, params, &NoProgress);
         assert!(stats.grids > 0);
-        let (lie, brute) = (LieVisibility::new(&scene, &octree, &plie), Brute::new(&scene));
-        let grid = LieVisibility::with_grids(&scene, &octree, &plie);
+        let brute = Brute::new(&scene);
+        let modes = PLIE_MODES.map(|m| (m, LieVisibility::new(&scene, &octree, &plie, m)));
         let mut ctx = QueryCtx::new(scene.triangles.len());
         let mut rng = Rng(5);
         let light = &scene.lights[0];
         let (mut n, mut blocked) = (0, 0);
         while n < 100_000 {
             let t = (rng.f() * scene.triangles.len() as f32) as usize % scene.triangles.len();
-            let x = if n % 3 == 0 {
+            // A point on a leaf face lies on no triangle: no origin triangle (x must lie on its own).
+            let (x, t) = if n % 3 == 0 {
                 let c = octree.leaf_bounds(LeafId((rng.f() * octree.leaf_count() as f32) as u32));
-                Vec3::new(c.min.x, c.min.y + rng.f() * (c.max.y - c.min.y), c.max.z)
+                (Vec3::new(c.min.x, c.min.y + rng.f() * (c.max.y - c.min.y), c.max.z), u32::MAX as usize)
             } else {
-                scene.triangles[t].point(rng.f() * 0.5, rng.f() * 0.5)
+                (scene.triangles[t].point(rng.f() * 0.5, rng.f() * 0.5), t)
             };
             let y = light.sample(Vec2::new(rng.f(), rng.f()));
             if (x - y).dot(light.normal) <= 0.0 {
@@ -181,8 +187,9 @@ fn lie_mode_matches_brute_force_in_the_room() {
             }
             let ray = ShadowRay::new(x, y, LightId(0), plie::TriId(t as u32), octree.locate(x));
             let expect = brute.occluded(&ray, &mut ctx);
-            assert_eq!(lie.occluded(&ray, &mut ctx), expect, "lie, ray {n}: {ray:?}");
-            assert_eq!(grid.occluded(&ray, &mut ctx), expect, "grid, ray {n}: {ray:?}");
+            for (m, v) in &modes {
+                assert_eq!(v.occluded(&ray, &mut ctx), expect, "{m}, ray {n}: {ray:?}");
+            }
             blocked += expect as usize;
             n += 1;
         }
@@ -219,8 +226,8 @@ fn lie_mode_matches_brute_force_with_lights_tilted_to_grazing() {
     let params = PlieParams { max_triangles: 8, ..PlieParams::default() };
     let octree = Octree::build(&scene, params.octree());
     let (plie, _) = plie::construct::build(&scene, &octree, params, &NoProgress);
-    let (lie, brute) = (LieVisibility::new(&scene, &octree, &plie), Brute::new(&scene));
-    let grid = LieVisibility::with_grids(&scene, &octree, &plie);
+    let brute = Brute::new(&scene);
+    let modes = PLIE_MODES.map(|m| (m, LieVisibility::new(&scene, &octree, &plie, m)));
     let mut ctx = QueryCtx::new(scene.triangles.len());
     let mut rng = Rng(17);
     let (mut n, mut blocked) = (0, 0);
@@ -228,12 +235,12 @@ fn lie_mode_matches_brute_force_with_lights_tilted_to_grazing() {
         let li = n % scene.lights.len();
         let light = &scene.lights[li];
         let t = ((rng.f() * scene.triangles.len() as f32) as usize).min(scene.triangles.len() - 1);
-        let x = if n % 4 == 0 {
+        let (x, t) = if n % 4 == 0 {
             let c =
                 octree.leaf_bounds(LeafId((rng.f() * octree.leaf_count() as f32) as u32 % octree.leaf_count() as u32));
-            Vec3::new(c.max.x, c.min.y + rng.f() * (c.max.y - c.min.y), c.min.z)
+            (Vec3::new(c.max.x, c.min.y + rng.f() * (c.max.y - c.min.y), c.min.z), u32::MAX as usize)
         } else {
-            scene.triangles[t].point(rng.f() * 0.5, rng.f() * 0.5)
+            (scene.triangles[t].point(rng.f() * 0.5, rng.f() * 0.5), t)
         };
         let y = light.sample(Vec2::new(rng.f(), rng.f()));
         if (x - y).dot(light.normal) <= 0.0 {
@@ -241,8 +248,9 @@ fn lie_mode_matches_brute_force_with_lights_tilted_to_grazing() {
         }
         let ray = ShadowRay::new(x, y, LightId(li as u32), plie::TriId(t as u32), octree.locate(x));
         let expect = brute.occluded(&ray, &mut ctx);
-        assert_eq!(lie.occluded(&ray, &mut ctx), expect, "lie, ray {n} toward light {li}: {ray:?}");
-        assert_eq!(grid.occluded(&ray, &mut ctx), expect, "grid, ray {n} toward light {li}: {ray:?}");
+        for (m, v) in &modes {
+            assert_eq!(v.occluded(&ray, &mut ctx), expect, "{m}, ray {n} toward light {li}: {ray:?}");
+        }
         blocked += expect as usize;
         n += 1;
     }
@@ -287,7 +295,9 @@ fn grid_cells_contain_every_triangle_between_cell_and_light() {
         let leaf = octree.leaf_bounds(r.leaf);
         for j in 0..g.res {
             for i in 0..g.res {
-                let list = plie.cell_blockers_of(g, (j * g.res + i) as usize);
+                let plie::lie::Cell::Blockers(list) = plie.cell(g, (j * g.res + i) as usize) else {
+                    continue; // Umbra cells: tests/regions.rs.
+                };
                 let q = r.face.face_corners(&cell_box(r.face, &leaf, g.res, i, j));
                 for _ in 0..16 {
                     let f = q[0] + (q[1] - q[0]) * rng.f() + (q[3] - q[0]) * rng.f();

@@ -6,19 +6,28 @@
 //! Each cell's list is found exactly as a record's list is (SPEC §4.4): the supporting planes of
 //! conv(cell ∪ light), moved outward by the tolerance, clip the record's blockers. Because of that
 //! tolerance, a crossing point computed with rounding error near a cell border is still covered by the
-//! cell it is assigned to. (Umbra cells need the regions of SPEC §4.5 and are not classified here.)
+//! cell it is assigned to. Cells inside the record's umbra (SPEC §4.5, [`super::regions`]) are
+//! marked by the construction afterwards: a ray crossing there is blocked without a test.
 
+use glam::DVec2;
+
+use super::regions::{FaceRegions, UNITS};
 use super::shaft::Shaft;
 use crate::geometry::Aabb;
 use crate::octree::Dir;
 use crate::scene::{Light, Scene, TriId};
 
-/// Records with fewer blockers than this keep no grid: their list is short already.
+/// Records with fewer blockers than this keep no grid: their list is short already (unless they have
+/// umbra to classify).
 pub const MIN_BLOCKERS: usize = 8;
 
-/// Cells per side for a record with `n` blockers: a power of two near `sqrt(n) / 2`, from 2 to 8.
-pub fn resolution(n: usize) -> u32 {
-    let want = ((n as f64).sqrt() / 2.0).ceil().clamp(2.0, 8.0) as u32;
+/// Fewest cells per side of the grid of a record with umbra.
+pub const UMBRA_MIN_RES: u32 = 4;
+
+/// Cells per side for a record with `n` blockers: a power of two near `sqrt(n) / 2`, from `min` (a
+/// power of two) to 8.
+pub fn resolution(n: usize, min: u32) -> u32 {
+    let want = ((n as f64).sqrt() / 2.0).ceil().clamp(min as f64, 8.0) as u32;
     want.next_power_of_two().min(8)
 }
 
@@ -55,6 +64,8 @@ pub struct PendingGrid {
     pub lists: Vec<Vec<TriId>>,
     /// List index of each cell.
     pub cell_list: Vec<u32>,
+    /// Cells fully in umbra (empty until the regions have classified them).
+    pub umbra: Vec<bool>,
 }
 
 /// A square is split into four only if the four lists together hold at most this many times the
@@ -64,7 +75,8 @@ pub struct PendingGrid {
 /// lists of cornell-bunny.obj hold 1.5x the record lists (4.0: 35x).
 const SPLIT_GROWTH: f64 = 2.5;
 
-/// The grid of one record, or `None` when the record has too few blockers to need one.
+/// The grid of one record with at least `min_res` cells per side, or `None` when `min_res` is 0 and
+/// the record has too few blockers to need one.
 pub fn face_grid(
     scene: &Scene,
     face: Dir,
@@ -72,12 +84,13 @@ pub fn face_grid(
     light: &Light,
     blockers: &[TriId],
     tol: f32,
+    min_res: u32,
 ) -> Option<PendingGrid> {
-    if blockers.len() < MIN_BLOCKERS {
+    if blockers.len() < MIN_BLOCKERS && min_res == 0 {
         return None;
     }
-    let g = resolution(blockers.len());
-    let mut out = PendingGrid { g, lists: Vec::new(), cell_list: vec![u32::MAX; (g * g) as usize] };
+    let g = resolution(blockers.len(), min_res.max(2));
+    let mut out = PendingGrid { g, lists: Vec::new(), cell_list: vec![u32::MAX; (g * g) as usize], umbra: Vec::new() };
     let quad = Quad { scene, face, cell, light, tol, g };
     quad.split(0, 0, g, blockers, &mut out);
     debug_assert!(out.cell_list.iter().all(|&c| (c as usize) < out.lists.len()));
@@ -141,6 +154,19 @@ impl Quad<'_> {
             }
         }
     }
+}
+
+/// Which cells of a `g x g` grid lie fully in the umbra of `regions`.
+pub fn umbra_cells(g: u32, regions: &FaceRegions) -> Vec<bool> {
+    let w = UNITS / g as f64;
+    let mut out = Vec::with_capacity((g * g) as usize);
+    for j in 0..g {
+        for i in 0..g {
+            let lo = DVec2::new(i as f64 * w, j as f64 * w);
+            out.push(regions.square_in_umbra(lo, lo + w));
+        }
+    }
+    out
 }
 
 /// The cell of a `g x g` face grid that the face point `p` falls in (clamped to the face).

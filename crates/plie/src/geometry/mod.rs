@@ -5,6 +5,7 @@
 //! every visibility mode answers the same shadow ray identically).
 
 pub mod aabb;
+pub mod clip;
 pub mod ray_triangle;
 pub mod segment;
 pub mod tri_box;

@@ -24,14 +24,14 @@ use xxhash_rust::xxh3::{xxh3_64, Xxh3};
 
 use super::atomic::write_atomic;
 use crate::error::{Error, Result};
-use crate::lie::{Plie, PlieParams, NO_RECORD};
+use crate::lie::{Plie, PlieParams, NO_RECORD, UMBRA_CELL};
 use crate::octree::Octree;
 use crate::scene::Scene;
 
 /// First bytes of every `.plie` file.
 pub const MAGIC: [u8; 8] = *b"PLIE\r\n\x1a\n";
 /// Version of the layout written by this build of plie.
-pub const FORMAT_VERSION: u32 = 1;
+pub const FORMAT_VERSION: u32 = 2;
 const HEADER: usize = 8 + 4 + 8 + 8;
 
 /// What a `.plie` file holds after its header.
@@ -203,8 +203,21 @@ fn check_structure(p: &Plie, scene: &Scene, octree: &Octree) -> std::result::Res
             return Err(format!("record {i}: face grid out of bounds"));
         }
     }
-    if p.cells.iter().any(|&(s, n)| s as u64 + n as u64 > p.cell_blockers.len() as u64) {
+    if p.cells.iter().any(|&c| c != UMBRA_CELL && c.0 as u64 + c.1 as u64 > p.cell_blockers.len() as u64) {
         return Err("grid cell list out of bounds".into());
+    }
+    if p.regions.len() != p.records.len() {
+        return Err("region table has the wrong size".into());
+    }
+    let n = p.region_tris.len() as u64;
+    for (i, r) in p.regions.iter().enumerate() {
+        if r.umbra_start as u64 + r.umbra_len as u64 > n || r.penumbra_start as u64 + r.penumbra_len as u64 > n {
+            return Err(format!("record {i}: region triangles out of bounds"));
+        }
+    }
+    let units = crate::construct::regions::UNITS as i32;
+    if p.region_tris.iter().flatten().flatten().any(|&c| c.abs() > 4 * units) {
+        return Err("region triangle out of range".into());
     }
     Ok(())
 }

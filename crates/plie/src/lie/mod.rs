@@ -3,10 +3,13 @@
 //! that light enters the cell through that face (SPEC §4.1).
 //!
 //! Layout: one `u32` per (leaf, face, light) in `record_index` (O(1) lookup, `NO_RECORD` where there is
-//! none), the records in one flat array, and all blocker lists concatenated in `blockers`.
+//! none), the records in one flat array, and all blocker lists concatenated in `blockers`. Parallel to
+//! the records: their umbra/penumbra triangles (§4.5, in the face's integer units, see
+//! [`crate::construct::regions::FaceFrame`]) and their face grids.
 
 use serde::{Deserialize, Serialize};
 
+use crate::construct::regions::Tri2;
 use crate::octree::{Dir, LeafId};
 use crate::scene::{LightId, TriId};
 
@@ -22,13 +25,17 @@ pub struct PlieParams {
     pub max_depth: u32,
     /// Build face grids (per-cell blocker lists, our addition; used by mode `grid`).
     pub grids: bool,
+    /// Compute umbra and penumbra (SPEC §4.5) and remove fully dark records (§4.6). The thesis' Table
+    /// 8.4 measured construction without them.
+    pub regions: bool,
 }
 
 impl PlieParams {
-    /// The thesis' test 1: 200 triangles per leaf, no refinement, nothing the thesis did not have.
+    /// The thesis' test 1: 200 triangles per leaf, umbra and penumbra, no refinement, nothing the
+    /// thesis did not have.
     pub fn thesis() -> PlieParams {
         let o = crate::octree::OctreeParams::thesis();
-        PlieParams { max_triangles: o.max_triangles, max_depth: o.max_depth, grids: false }
+        PlieParams { max_triangles: o.max_triangles, max_depth: o.max_depth, grids: false, regions: true }
     }
 
     /// The octree part of the parameters.
@@ -38,7 +45,7 @@ impl PlieParams {
 }
 
 impl Default for PlieParams {
-    /// The thesis' parameters plus face grids.
+    /// The thesis' parameters (with umbra and penumbra) plus face grids.
     fn default() -> PlieParams {
         PlieParams { grids: true, ..PlieParams::thesis() }
     }
@@ -57,6 +64,31 @@ pub struct Record {
     pub blockers_start: u32,
     /// Length of the blocker list.
     pub blockers_len: u32,
+}
+
+/// A record's umbra and penumbra triangles: ranges into [`Plie::region_tris`].
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub struct RecordRegions {
+    /// First umbra triangle.
+    pub umbra_start: u32,
+    /// Umbra triangles.
+    pub umbra_len: u32,
+    /// First penumbra triangle.
+    pub penumbra_start: u32,
+    /// Penumbra triangles.
+    pub penumbra_len: u32,
+}
+
+/// `(start, len)` of a grid cell fully in umbra (no blocker list needed).
+pub const UMBRA_CELL: (u32, u32) = (u32::MAX, u32::MAX);
+
+/// What a face-grid cell says about rays crossing the face inside it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Cell<'a> {
+    /// Fully in umbra: every ray through it is blocked.
+    Umbra,
+    /// Test these blockers (none: fully lit by the blockers).
+    Blockers(&'a [TriId]),
 }
 
 /// A record's face grid (see [`crate::construct::grid`]): `res x res` cells whose blocker lists are
@@ -90,6 +122,11 @@ pub struct Plie {
     pub cells: Vec<(u32, u32)>,
     /// All cell blocker lists, concatenated.
     pub cell_blockers: Vec<TriId>,
+    /// The umbra/penumbra triangles of each record (parallel to `records`; all empty without
+    /// regions).
+    pub regions: Vec<RecordRegions>,
+    /// All region triangles, concatenated.
+    pub region_tris: Vec<Tri2>,
 }
 
 impl Plie {
@@ -120,11 +157,27 @@ impl Plie {
         &self.blockers[r.blockers_start as usize..(r.blockers_start + r.blockers_len) as usize]
     }
 
-    /// The blockers of cell `c` of record `r`'s grid.
+    /// Cell `c` of record `r`'s grid.
     #[inline]
-    pub fn cell_blockers_of(&self, grid: &FaceGrid, c: usize) -> &[TriId] {
-        let (s, n) = self.cells[grid.cells_start as usize + c];
-        &self.cell_blockers[s as usize..(s + n) as usize]
+    pub fn cell(&self, grid: &FaceGrid, c: usize) -> Cell<'_> {
+        match self.cells[grid.cells_start as usize + c] {
+            UMBRA_CELL => Cell::Umbra,
+            (s, n) => Cell::Blockers(&self.cell_blockers[s as usize..(s + n) as usize]),
+        }
+    }
+
+    /// The umbra triangles of record `r`.
+    #[inline]
+    pub fn umbra_of(&self, r: usize) -> &[Tri2] {
+        let g = &self.regions[r];
+        &self.region_tris[g.umbra_start as usize..(g.umbra_start + g.umbra_len) as usize]
+    }
+
+    /// The penumbra triangles of record `r`.
+    #[inline]
+    pub fn penumbra_of(&self, r: usize) -> &[Tri2] {
+        let g = &self.regions[r];
+        &self.region_tris[g.penumbra_start as usize..(g.penumbra_start + g.penumbra_len) as usize]
     }
 
     /// Bytes held in memory by the P-LIE's arrays.
@@ -135,6 +188,8 @@ impl Plie {
             + self.grids.len() * std::mem::size_of::<FaceGrid>()
             + self.cells.len() * 8
             + self.cell_blockers.len() * std::mem::size_of::<TriId>()
+            + self.regions.len() * std::mem::size_of::<RecordRegions>()
+            + self.region_tris.len() * std::mem::size_of::<Tri2>()
     }
 
     /// Mean and maximum blockers per record.

@@ -1,16 +1,26 @@
-//! SPEC §5 mode (b), LIE / blockers: the segment from `x` (in leaf `c`) to the light sample leaves `c`
-//! through one face `F`. No record for (F, light): occluded. Otherwise test the record's blockers
-//! (they cover the part of the segment beyond `F`, which lies in conv(F ∪ light)), then the triangles
-//! of `c` itself (the part inside `c`). A segment that never leaves `c` only needs `c`'s triangles.
+//! SPEC §5 modes (b)-(d) and our `grid`, all answered from the P-LIE. The segment from `x` (in leaf
+//! `c`) to the light sample leaves `c` through one face `F`, crossing it at `f`. No record for
+//! (F, light): occluded. Otherwise, by mode:
+//!
+//! - `lie` (b): test the record's blockers (they cover the part of the segment beyond `F`, which lies
+//!   in conv(F ∪ light));
+//! - `umbra` (c): `f` in the record's umbra triangles: occluded; else as (b);
+//! - `penumbra` (d): as (c), and `f` outside both umbra and penumbra: no blocker can hit, skip them;
+//! - `grid`: the face-grid cell of `f` says umbra (occluded) or which blockers to test.
+//!
+//! Then the triangles of `c` itself (the part of the segment inside `c`). A segment that never leaves
+//! `c` only needs `c`'s triangles. Regions are conservative (see [`crate::construct::regions`]), so
+//! every mode answers exactly as the blocker test would.
 
-use super::{blocks, OctreeVisibility, QueryCtx, ShadowRay, Visibility};
+use super::{blocks, Mode, OctreeVisibility, QueryCtx, ShadowRay, Visibility};
 use crate::construct::grid;
+use crate::construct::regions::{in_triangles, FaceFrame};
 use crate::geometry::{Aabb, Segment};
-use crate::lie::Plie;
+use crate::lie::{Cell, Plie};
 use crate::octree::{Dir, LeafId, Octree};
 use crate::scene::{Scene, TriId};
 
-/// Mode (b): the P-LIE's blocker lists.
+/// Modes (b)-(d) and `grid`: the P-LIE's blocker lists, regions and face grids.
 ///
 /// Before a candidate gets the watertight test, its bounding box (grown by the construction tolerance)
 /// is tested against the segment: a conservative cull (SPEC §8 point 4) that never changes an answer.
@@ -20,22 +30,18 @@ pub struct LieVisibility<'a> {
     plie: &'a Plie,
     /// Grown bounding box of every triangle.
     tri_boxes: Vec<Aabb>,
-    /// Use the records' face grids (mode `grid`) instead of their whole lists (mode `lie`).
-    use_grids: bool,
+    /// `Lie`, `Umbra`, `Penumbra` or `Grid`.
+    mode: Mode,
 }
 
 impl<'a> LieVisibility<'a> {
-    /// Mode (b) over a P-LIE built for `scene` and `octree`.
-    pub fn new(scene: &'a Scene, octree: &'a Octree, plie: &'a Plie) -> LieVisibility<'a> {
+    /// Mode `mode` (one of `Lie`, `Umbra`, `Penumbra`, `Grid`; others answer as `Lie`) over a P-LIE
+    /// built for `scene` and `octree`. Without regions or grids in the P-LIE, the modes that use them
+    /// test the blockers instead (still exact).
+    pub fn new(scene: &'a Scene, octree: &'a Octree, plie: &'a Plie, mode: Mode) -> LieVisibility<'a> {
         let pad = scene.scale() * crate::construct::TOLERANCE_REL;
         let tri_boxes = scene.triangles.iter().map(|t| t.aabb().expanded(pad)).collect();
-        LieVisibility { scene, octree, plie, tri_boxes, use_grids: false }
-    }
-
-    /// Mode `grid`: as mode (b), but a ray tests only the blockers of the face-grid cell where it
-    /// crosses the face (see [`crate::construct::grid`]).
-    pub fn with_grids(scene: &'a Scene, octree: &'a Octree, plie: &'a Plie) -> LieVisibility<'a> {
-        LieVisibility { use_grids: true, ..LieVisibility::new(scene, octree, plie) }
+        LieVisibility { scene, octree, plie, tri_boxes, mode }
     }
 
     /// The box cull, then the shared predicate.
@@ -79,13 +85,29 @@ impl Visibility for LieVisibility<'_> {
             let Some(ri) = self.plie.record_id(leaf, face, ray.light) else {
                 return true;
             };
-            let grid = &self.plie.grids[ri];
-            let list = if self.use_grids && grid.res > 0 {
-                let f = ray.test.origin + ray.test.dir * t_exit;
-                let c = grid::cell_of(face, &self.octree.leaf_bounds(leaf), grid.res, f);
-                self.plie.cell_blockers_of(grid, c)
-            } else {
-                self.plie.blockers_of(&self.plie.records[ri])
+            let f = ray.test.origin + ray.test.dir * t_exit;
+            let record = || self.plie.blockers_of(&self.plie.records[ri]);
+            let list = match self.mode {
+                Mode::Umbra | Mode::Penumbra => {
+                    let x = FaceFrame::new(face, &self.octree.leaf_bounds(leaf)).units(f.as_dvec3());
+                    if in_triangles(self.plie.umbra_of(ri), x) {
+                        return true;
+                    }
+                    if self.mode == Mode::Penumbra && !in_triangles(self.plie.penumbra_of(ri), x) {
+                        &[]
+                    } else {
+                        record()
+                    }
+                }
+                Mode::Grid if self.plie.grids[ri].res > 0 => {
+                    let grid = &self.plie.grids[ri];
+                    let c = grid::cell_of(face, &self.octree.leaf_bounds(leaf), grid.res, f);
+                    match self.plie.cell(grid, c) {
+                        Cell::Umbra => return true,
+                        Cell::Blockers(list) => list,
+                    }
+                }
+                _ => record(),
             };
             for &t in list {
                 if self.test(&seg, ray, t, ctx) {

@@ -61,12 +61,14 @@ pub fn for_mode<'a>(
         Mode::Brute => Box::new(Brute::new(scene)),
         Mode::Octree => Box::new(OctreeVisibility::new(scene, octree)),
         Mode::Bvh => Box::new(BvhVisibility::new(scene, bvh)),
-        Mode::Lie | Mode::Grid => {
+        Mode::Lie | Mode::Umbra | Mode::Penumbra | Mode::Grid => {
             let plie = plie.ok_or_else(|| crate::Error::InvalidParameter(format!("mode {mode} needs a P-LIE")))?;
-            match mode {
-                Mode::Grid => Box::new(LieVisibility::with_grids(scene, octree, plie)),
-                _ => Box::new(LieVisibility::new(scene, octree, plie)),
+            if mode.needs_regions() && !plie.params.regions {
+                return Err(crate::Error::InvalidParameter(format!(
+                    "mode {mode} needs umbra and penumbra, but the P-LIE was built without them (--no-regions)"
+                )));
             }
+            Box::new(LieVisibility::new(scene, octree, plie, mode))
         }
         #[cfg(feature = "embree")]
         Mode::Embree => Box::new(EmbreeVisibility::new(scene)?),

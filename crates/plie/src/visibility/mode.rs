@@ -15,7 +15,12 @@ pub enum Mode {
     Bvh,
     /// SPEC §5 mode (b): the P-LIE's blocker lists.
     Lie,
-    /// Mode (b) with face grids: only the blockers of the cell where the ray crosses the face.
+    /// SPEC §5 mode (c): as `lie`, but a ray crossing the face in the umbra triangles is blocked.
+    Umbra,
+    /// SPEC §5 mode (d): as `umbra`, and a ray crossing outside umbra and penumbra skips the blockers.
+    Penumbra,
+    /// Ours: face grids. The cell where the ray crosses the face says umbra (blocked), or which
+    /// blockers to test (none: lit).
     Grid,
     /// Intel Embree 3 proposing candidates to the shared predicate (cargo feature `embree`).
     #[cfg(feature = "embree")]
@@ -25,10 +30,12 @@ pub enum Mode {
 impl Mode {
     /// Every mode, for tests that compare them all.
     #[cfg(not(feature = "embree"))]
-    pub const ALL: [Mode; 5] = [Mode::Brute, Mode::Octree, Mode::Bvh, Mode::Lie, Mode::Grid];
+    pub const ALL: [Mode; 7] =
+        [Mode::Brute, Mode::Octree, Mode::Bvh, Mode::Lie, Mode::Umbra, Mode::Penumbra, Mode::Grid];
     /// Every mode, for tests that compare them all.
     #[cfg(feature = "embree")]
-    pub const ALL: [Mode; 6] = [Mode::Brute, Mode::Octree, Mode::Bvh, Mode::Lie, Mode::Grid, Mode::Embree];
+    pub const ALL: [Mode; 8] =
+        [Mode::Brute, Mode::Octree, Mode::Bvh, Mode::Lie, Mode::Umbra, Mode::Penumbra, Mode::Grid, Mode::Embree];
 
     /// The name used on the command line.
     pub fn name(self) -> &'static str {
@@ -37,6 +44,8 @@ impl Mode {
             Mode::Octree => "octree",
             Mode::Bvh => "bvh",
             Mode::Lie => "lie",
+            Mode::Umbra => "umbra",
+            Mode::Penumbra => "penumbra",
             Mode::Grid => "grid",
             #[cfg(feature = "embree")]
             Mode::Embree => "embree",
@@ -45,7 +54,12 @@ impl Mode {
 
     /// True if the mode answers from a P-LIE.
     pub fn needs_plie(self) -> bool {
-        matches!(self, Mode::Lie | Mode::Grid)
+        matches!(self, Mode::Lie | Mode::Umbra | Mode::Penumbra | Mode::Grid)
+    }
+
+    /// True if the mode needs the P-LIE's umbra and penumbra (built with `regions`).
+    pub fn needs_regions(self) -> bool {
+        matches!(self, Mode::Umbra | Mode::Penumbra)
     }
 }
 

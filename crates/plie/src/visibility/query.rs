@@ -19,7 +19,8 @@ pub struct ShadowRay {
     pub test: RayTest,
     /// The light sampled.
     pub light: LightId,
-    /// The triangle `x` lies on (never counts as a blocker).
+    /// The triangle `x` lies on (never counts as a blocker). `x` must lie on it, up to rounding, as a
+    /// shaded point does; a point on no triangle passes an id no triangle has (e.g. `TriId(u32::MAX)`).
     pub origin_tri: TriId,
     /// The octree leaf containing `x`, when known (from the hit buffer).
     pub leaf: Option<LeafId>,
