@@ -1,15 +1,19 @@
 //! Octree tests (SPEC §3 and SPEC §5 mode (a)) on generated scenes and on every built-in scene that
 //! loads: triangle assignment against brute force, point location with its tie-break, conservative
 //! front-to-back traversal against an f64 reference, `OctreeVisibility` against `Brute` on 10^5
-//! segments per scene (many of them on cell faces, edges and corners), and thread-count determinism.
+//! segments per scene (many of them on cell faces, edges and corners), thread-count determinism, and
+//! the neighbour queries of every node in all 26 directions, and its leaves on each face, against a
+//! reference on integer cell coordinates.
 //!
 //! A hand-run timing is at the end: `cargo test -p plie --test octree -- --ignored --nocapture`.
+
+use std::collections::HashMap;
 
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;
 
 use plie::geometry::{triangle_overlaps_box, Aabb};
-use plie::octree::{LeafId, Octree, OctreeParams};
+use plie::octree::{Dir, LeafId, Neighbour, NodeId, Octree, OctreeParams, MAX_DEPTH_LIMIT};
 use plie::visibility::{Brute, OctreeVisibility, QueryCtx, ShadowRay, Visibility};
 use plie::{LightId, Scene, SceneBuilder, TriId};
 
@@ -446,6 +450,164 @@ fn build_is_deterministic_across_thread_counts() {
             let b = two.install(|| Octree::build(&s, params));
             let c = two.install(|| Octree::build(&s, params));
             assert!(a == b && b == c, "{}: builds differ", s.name);
+        }
+    }
+}
+
+/// A cell in integer coordinates of the finest possible grid over the root: lower corner and size.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+struct Cell {
+    min: [i64; 3],
+    size: i64,
+}
+
+/// Converts boxes to [`Cell`]s, independently of how the octree computes its boxes.
+struct Grid {
+    min: DVec3,
+    size: f64,
+}
+
+impl Grid {
+    const RES: i64 = 1 << MAX_DEPTH_LIMIT;
+
+    fn new(o: &Octree) -> Grid {
+        let r = o.root_bounds();
+        Grid { min: r.min.as_dvec3(), size: r.size().x as f64 }
+    }
+
+    fn snap(&self, x: f64) -> i64 {
+        let q = x / self.size * Grid::RES as f64;
+        assert!((q - q.round()).abs() < 0.05, "{q} is not on the grid");
+        q.round() as i64
+    }
+
+    fn cell(&self, b: &Aabb) -> Cell {
+        let min = (b.min.as_dvec3() - self.min).to_array().map(|x| self.snap(x));
+        Cell { min, size: self.snap(b.max.x as f64 - b.min.x as f64) }
+    }
+
+    /// The centre of a cell.
+    fn center(&self, c: &Cell) -> Vec3 {
+        let q = DVec3::from_array(c.min.map(|m| m as f64)) + DVec3::splat(c.size as f64 / 2.0);
+        (self.min + q / Grid::RES as f64 * self.size).as_vec3()
+    }
+}
+
+/// The 26 direction sets: steps in {-1, 0, 1}^3 and the directions they name.
+fn direction_sets() -> Vec<([i64; 3], Vec<Dir>)> {
+    (0..27)
+        .map(|s| [s % 3 - 1, s / 3 % 3 - 1, s / 9 - 1])
+        .filter(|step| *step != [0; 3])
+        .map(|step| (step, (0..3).filter(|&k| step[k] != 0).map(|k| Dir::from_axis(k, step[k] > 0)).collect()))
+        .collect()
+}
+
+/// The reference answer: the node with exactly the shifted cell, else the (larger) leaf holding its
+/// centre, else nothing when the shifted cell leaves the root.
+fn reference_neighbour(o: &Octree, grid: &Grid, cells: &HashMap<Cell, NodeId>, c: Cell, step: [i64; 3]) -> Neighbour {
+    let shifted = Cell { min: std::array::from_fn(|k| c.min[k] + step[k] * c.size), size: c.size };
+    if shifted.min.iter().any(|&m| m < 0 || m + c.size > Grid::RES) {
+        return Neighbour::None;
+    }
+    if let Some(&n) = cells.get(&shifted) {
+        return Neighbour::Equal(n);
+    }
+    let l = o.locate(grid.center(&shifted)).expect("inside the root");
+    let lc = grid.cell(&o.leaf_bounds(l));
+    let inside = (0..3).all(|k| lc.min[k] <= shifted.min[k] && shifted.min[k] + c.size <= lc.min[k] + lc.size);
+    assert!(inside && lc.size > c.size, "leaf {l:?} {lc:?} does not cover the missing cell {shifted:?}");
+    Neighbour::Larger(l)
+}
+
+#[test]
+fn neighbours_match_the_integer_reference_in_all_26_directions() {
+    let sets = direction_sets();
+    let mut kinds = [0usize; 3];
+    for s in scenes() {
+        for params in param_sets(&s) {
+            let o = Octree::build(&s, params);
+            let grid = Grid::new(&o);
+            let cells: HashMap<Cell, NodeId> = o.nodes().map(|n| (grid.cell(&o.node_bounds(n)), n)).collect();
+            assert_eq!(cells.len(), o.node_count(), "{}: two nodes with one box", s.name);
+            let counts = o
+                .nodes()
+                .collect::<Vec<_>>()
+                .into_par_iter()
+                .map(|n| {
+                    let c = grid.cell(&o.node_bounds(n));
+                    let mut kinds = [0usize; 3];
+                    for (step, dirs) in &sets {
+                        let want = reference_neighbour(&o, &grid, &cells, c, *step);
+                        let got = o.neighbour(n, dirs);
+                        assert_eq!(got, want, "{}: node {n:?} {c:?}, {dirs:?}", s.name);
+                        let mut reversed = dirs.clone();
+                        reversed.reverse();
+                        assert_eq!(o.neighbour(n, &reversed), got, "{}: order of {dirs:?}", s.name);
+                        kinds[match got {
+                            Neighbour::Equal(_) => 0,
+                            Neighbour::Larger(_) => 1,
+                            Neighbour::None => 2,
+                        }] += 1;
+                    }
+                    kinds
+                })
+                .reduce(|| [0; 3], |a, b| std::array::from_fn(|i| a[i] + b[i]));
+            (0..3).for_each(|i| kinds[i] += counts[i]);
+        }
+    }
+    assert!(kinds.iter().all(|&k| k > 1000), "equal / larger / none answers: {kinds:?}");
+}
+
+#[test]
+fn leaves_on_faces_match_the_integer_reference() {
+    for s in scenes() {
+        for params in param_sets(&s) {
+            let o = Octree::build(&s, params);
+            let grid = Grid::new(&o);
+            let cells: HashMap<Cell, NodeId> = o.nodes().map(|n| (grid.cell(&o.node_bounds(n)), n)).collect();
+            // want[node][face]: every leaf under the node touching that face, by ascending id; index 6
+            // holds all the leaves under the node. Ancestors are found by rounding the leaf's cell down
+            // to coarser sizes, not through the tree's links.
+            let mut want = vec![[(); 7].map(|_| Vec::new()); o.node_count()];
+            for l in o.leaves() {
+                let lc = grid.cell(&o.leaf_bounds(l));
+                let mut size = lc.size;
+                while size <= Grid::RES {
+                    let a = Cell { min: lc.min.map(|m| m - m.rem_euclid(size)), size };
+                    if let Some(&n) = cells.get(&a) {
+                        want[n.idx()][6].push(l);
+                        for face in Dir::ALL {
+                            let k = face.axis();
+                            let touches = if face.is_positive() {
+                                lc.min[k] + lc.size == a.min[k] + size
+                            } else {
+                                lc.min[k] == a.min[k]
+                            };
+                            if touches {
+                                want[n.idx()][face.index()].push(l);
+                            }
+                        }
+                    }
+                    size *= 2;
+                }
+            }
+            let mut got = Vec::new();
+            for n in o.nodes() {
+                for face in Dir::ALL {
+                    got.clear();
+                    o.leaves_on_face(n, face, &mut got);
+                    got.sort();
+                    assert_eq!(got, want[n.idx()][face.index()], "{}: node {n:?}, {face:?}", s.name);
+                }
+                got.clear();
+                o.leaves_under(n, &mut got);
+                got.sort();
+                assert_eq!(got, want[n.idx()][6], "{}: node {n:?}", s.name);
+                if let Some(l) = o.node_leaf(n) {
+                    assert_eq!(o.leaf_node(l), n);
+                }
+            }
+            assert_eq!(want[0][6].len(), o.leaf_count(), "{}: every leaf is under the root", s.name);
         }
     }
 }

@@ -73,6 +73,7 @@ impl Octree {
         let mut tree = Octree {
             nodes: vec![Node::UNSET],
             node_bounds: vec![root],
+            parents: Vec::new(),
             leaves: Vec::new(),
             leaf_tris: Vec::new(),
             eps,
@@ -94,6 +95,7 @@ impl Octree {
         }
         tree.nodes.shrink_to_fit();
         tree.node_bounds.shrink_to_fit();
+        tree.parents.shrink_to_fit();
         tree.leaves.shrink_to_fit();
         tree.leaf_tris.shrink_to_fit();
         tree
@@ -108,6 +110,8 @@ impl Octree {
                 Some(children) => {
                     let first = self.nodes.len() as u32;
                     self.nodes[p.node as usize] = Node::inner(first);
+                    debug_assert_eq!(first as usize, 1 + 8 * self.parents.len(), "child blocks start at 1 + 8 m");
+                    self.parents.push(p.node);
                     for (i, tris) in children.into_iter().enumerate() {
                         let bounds = child_box(&p.bounds, i);
                         self.nodes.push(Node::UNSET);

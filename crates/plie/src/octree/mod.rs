@@ -8,22 +8,28 @@
 //! Layout (flat arrays, `u32` indices, nothing allocated per node):
 //! - `nodes[0]` is the root; an inner node stores the index of its first child, and its 8 children are
 //!   consecutive. Child `i` of a cell is the octant with bit 0 = upper half in x, bit 1 = upper half in
-//!   y, bit 2 = upper half in z (see [`child_box`]). A leaf node stores its [`LeafId`].
+//!   y, bit 2 = upper half in z (see [`child_box`]). A leaf node stores its [`LeafId`]. Nodes are
+//!   addressed by [`NodeId`].
+//! - Children are allocated 8 at a time after the root, so the blocks start at `1 + 8 m`: node `n > 0`
+//!   is child `(n - 1) % 8` of `parents[(n - 1) / 8]` (one parent link per block, for the climbing
+//!   neighbour queries of [`neighbour`]).
 //! - `node_bounds[n]` is the box of node `n`; every box is computed from its parent's by [`child_box`],
 //!   so neighbouring cells share their faces bit for bit.
 //! - `leaves[l]` holds the leaf's node, depth and a range into `leaf_tris`, the concatenation of all
 //!   leaf triangle lists. Each list is sorted by ascending [`TriId`]. Leaves are numbered breadth-first.
 //!
 //! Stages: [`build`] (construction), [`locate`] (point location), [`traverse`] (segments and boxes),
-//! [`validate`] (invariant report).
+//! [`neighbour`] (face, edge and corner neighbours), [`validate`] (invariant report).
 
 pub mod build;
 pub mod dir;
 pub mod locate;
+pub mod neighbour;
 pub mod traverse;
 pub mod validate;
 
 pub use dir::Dir;
+pub use neighbour::Neighbour;
 
 use serde::{Deserialize, Serialize};
 
@@ -38,6 +44,21 @@ pub use validate::{OctreeReport, Violation};
 pub struct LeafId(pub u32);
 
 impl LeafId {
+    /// The index as `usize`.
+    #[inline]
+    pub fn idx(self) -> usize {
+        self.0 as usize
+    }
+}
+
+/// Index of an octree node, inner or leaf (`NodeId(0)` is the root). See the module doc for the layout.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub struct NodeId(pub u32);
+
+impl NodeId {
+    /// The root.
+    pub const ROOT: NodeId = NodeId(0);
+
     /// The index as `usize`.
     #[inline]
     pub fn idx(self) -> usize {
@@ -139,6 +160,8 @@ pub(crate) struct Leaf {
 pub struct Octree {
     pub(crate) nodes: Vec<Node>,
     pub(crate) node_bounds: Vec<Aabb>,
+    /// `parents[m]` is the parent of the 8 children `1 + 8 m ..= 8 + 8 m`.
+    pub(crate) parents: Vec<u32>,
     pub(crate) leaves: Vec<Leaf>,
     pub(crate) leaf_tris: Vec<TriId>,
     pub(crate) eps: f32,
@@ -178,6 +201,53 @@ impl Octree {
     /// All leaf ids, in breadth-first order.
     pub fn leaves(&self) -> impl ExactSizeIterator<Item = LeafId> + Clone {
         (0..self.leaves.len() as u32).map(LeafId)
+    }
+
+    /// All node ids, inner and leaf, root first.
+    pub fn nodes(&self) -> impl ExactSizeIterator<Item = NodeId> + Clone {
+        (0..self.nodes.len() as u32).map(NodeId)
+    }
+
+    /// The (unexpanded, closed) box of a node.
+    #[inline]
+    pub fn node_bounds(&self, n: NodeId) -> Aabb {
+        self.node_bounds[n.idx()]
+    }
+
+    /// The leaf a node is, or `None` for an inner node.
+    #[inline]
+    pub fn node_leaf(&self, n: NodeId) -> Option<LeafId> {
+        match self.nodes[n.idx()].kind() {
+            NodeKind::Leaf(l) => Some(l),
+            NodeKind::Inner(_) => None,
+        }
+    }
+
+    /// The 8 children of an inner node, child `i` being octant `i` (see [`child_box`]); `None` for a leaf.
+    #[inline]
+    pub fn node_children(&self, n: NodeId) -> Option<[NodeId; 8]> {
+        match self.nodes[n.idx()].kind() {
+            NodeKind::Inner(first) => Some(std::array::from_fn(|i| NodeId(first + i as u32))),
+            NodeKind::Leaf(_) => None,
+        }
+    }
+
+    /// The parent of a node, `None` for the root.
+    #[inline]
+    pub fn node_parent(&self, n: NodeId) -> Option<NodeId> {
+        (n.0 > 0).then(|| NodeId(self.parents[(n.idx() - 1) / 8]))
+    }
+
+    /// Which child of its parent a node is (0..8, see [`child_box`]); the root answers 0.
+    #[inline]
+    pub fn node_octant(&self, n: NodeId) -> usize {
+        n.idx().saturating_sub(1) % 8
+    }
+
+    /// The node of a leaf.
+    #[inline]
+    pub fn leaf_node(&self, l: LeafId) -> NodeId {
+        NodeId(self.leaves[l.idx()].node)
     }
 
     /// The (unexpanded, closed) box of a leaf.
@@ -234,6 +304,7 @@ impl Octree {
         size_of::<Octree>()
             + self.nodes.capacity() * size_of::<Node>()
             + self.node_bounds.capacity() * size_of::<Aabb>()
+            + self.parents.capacity() * size_of::<u32>()
             + self.leaves.capacity() * size_of::<Leaf>()
             + self.leaf_tris.capacity() * size_of::<TriId>()
     }

@@ -2,8 +2,8 @@
 //! tests run after every stage and `plie inspect` can print).
 //!
 //! Checked, independently of the build code:
-//! - structure: node links in range, every node and leaf reached exactly once from the root, root
-//!   split, stored boxes equal to the boxes recomputed top-down, stored depths right;
+//! - structure: node links in range, parent links matching them, every node and leaf reached exactly
+//!   once from the root, root split, stored boxes equal to the boxes recomputed top-down, stored depths right;
 //! - ranges: every leaf's range lies in the flat list, ranges are disjoint and cover it, triangle ids
 //!   exist and each list is strictly ascending;
 //! - size: no leaf over `max_triangles` unless at `max_depth`;
@@ -184,6 +184,10 @@ impl Octree {
             bad(format!("{} nodes but {} node boxes", self.nodes.len(), self.node_bounds.len()));
             return;
         }
+        if self.parents.len() != self.nodes.len().saturating_sub(1) / 8 {
+            bad(format!("{} nodes but {} parent links", self.nodes.len(), self.parents.len()));
+            return;
+        }
         if !matches!(self.nodes.first().map(|n| n.kind()), Some(NodeKind::Inner(_))) {
             bad("the root is not split".into());
             return;
@@ -202,6 +206,10 @@ impl Octree {
             }
             match self.nodes[n].kind() {
                 NodeKind::Inner(first) if first as usize + 8 <= self.nodes.len() && first as usize > n => {
+                    let block = (first as usize - 1) / 8;
+                    if (first - 1) % 8 != 0 || self.parents[block] as usize != n {
+                        bad(format!("node {n}: children {first}.. not a block whose parent link is {n}"));
+                    }
                     for i in 0..8 {
                         stack.push((first as usize + i, child_box(&b, i), depth + 1));
                     }
@@ -401,6 +409,9 @@ mod tests {
         assert!(o.validate(&s).violations.iter().any(|v| matches!(v, Violation::BadRange { .. })));
         let mut o = good.clone();
         o.node_bounds[3].max.x += 1.0;
+        assert!(o.validate(&s).violations.iter().any(|v| matches!(v, Violation::Structure(_))));
+        let mut o = good.clone();
+        o.parents[0] = 1;
         assert!(o.validate(&s).violations.iter().any(|v| matches!(v, Violation::Structure(_))));
     }
 }
