@@ -142,6 +142,10 @@ pub struct Shading {
     pub seconds: f64,
     pub rays: u64,
     pub triangle_tests_per_ray: f64,
+    /// Of `triangle_tests_per_ray`, the tests of P-LIE blockers (P-LIE modes; 0 in the others).
+    pub blocker_tests_per_ray: f64,
+    /// Of `triangle_tests_per_ray`, the tests of the ray's own leaf (P-LIE modes; 0 in the others).
+    pub own_leaf_tests_per_ray: f64,
     pub mrays_per_second: f64,
     pub mrays_per_second_per_core: f64,
 }
@@ -302,6 +306,7 @@ fn time_shading(
     let ((_, stats), seconds) = timed(runs, || shade(scene, hits, vis, n, 0, &NoProgress));
     let threads = rayon::current_num_threads();
     let mrays = stats.shadow_rays as f64 / seconds.max(1e-9) / 1e6;
+    let per_ray = |n: u64| n as f64 / stats.shadow_rays.max(1) as f64;
     Shading {
         mode,
         size,
@@ -309,7 +314,9 @@ fn time_shading(
         threads,
         seconds,
         rays: stats.shadow_rays,
-        triangle_tests_per_ray: stats.triangle_tests as f64 / stats.shadow_rays.max(1) as f64,
+        triangle_tests_per_ray: per_ray(stats.triangle_tests),
+        blocker_tests_per_ray: per_ray(stats.blocker_tests),
+        own_leaf_tests_per_ray: per_ray(stats.own_leaf_tests),
         mrays_per_second: mrays,
         mrays_per_second_per_core: mrays / threads as f64,
     }

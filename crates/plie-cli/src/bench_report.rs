@@ -84,18 +84,19 @@ fn write_text(path: &Path, text: &str) -> Result<()> {
 
 /// One row per measurement: construction, then shading (all threads and 1 thread).
 fn csv(r: &Results) -> String {
-    let mut s = String::from(
-        "kind,scene,triangles,mode,size,shadow_rays,threads,seconds,rays,tests_per_ray,mrays_per_s,mrays_per_s_per_core\n",
-    );
+    let mut s = String::from(concat!(
+        "kind,scene,triangles,mode,size,shadow_rays,threads,seconds,rays,tests_per_ray,mrays_per_s,mrays_per_s_per_core,",
+        "blocker_tests_per_ray,own_leaf_tests_per_ray\n"
+    ));
     for sc in &r.scenes {
         for b in &sc.builds {
             let _ =
-                writeln!(s, "build,{},{},plie-{},,,{},{},,,,", sc.name, sc.triangles, b.config, r.threads, b.seconds);
+                writeln!(s, "build,{},{},plie-{},,,{},{},,,,,,", sc.name, sc.triangles, b.config, r.threads, b.seconds);
         }
         for x in &sc.shading {
             let _ = writeln!(
                 s,
-                "shading,{},{},{},{},{},{},{},{},{},{},{}",
+                "shading,{},{},{},{},{},{},{},{},{},{},{},{},{}",
                 sc.name,
                 sc.triangles,
                 x.mode,
@@ -106,7 +107,9 @@ fn csv(r: &Results) -> String {
                 x.rays,
                 x.triangle_tests_per_ray,
                 x.mrays_per_second,
-                x.mrays_per_second_per_core
+                x.mrays_per_second_per_core,
+                x.blocker_tests_per_ray,
+                x.own_leaf_tests_per_ray
             );
         }
     }
