@@ -1,11 +1,11 @@
 //! `plie bench`: the thesis' measurement protocol (SPEC §7, Chapter 8) run in-process. For each scene:
-//! P-LIE construction with the thesis' test-1 parameters and with face grids; shading time of the
+//! P-LIE construction with the thesis' test-1 parameters (umbra/penumbra included), with face grids,
+//! and without regions (Table 8.4); shading time of the
 //! hit buffer (pass 2 alone) for every visibility mode but brute, at the thesis' image settings;
 //! shadow-ray throughput with one thread and with all; and the break-even number of images. The
 //! files are written by [`crate::bench_report`].
 //!
-//! Refinement (the thesis' test 2) and umbra/penumbra regions (modes c and d) do not exist yet, so
-//! they are not measured.
+//! Refinement (the thesis' test 2) does not exist yet, so it is not measured.
 
 use std::path::PathBuf;
 use std::time::Instant;
@@ -123,11 +123,13 @@ pub struct SceneResult {
 /// One P-LIE construction (median seconds of the construction alone, octree excluded).
 #[derive(Serialize)]
 pub struct BuildResult {
-    /// "thesis" (`PlieParams::thesis()`) or "grids" (`PlieParams::default()`).
+    /// "thesis" (`PlieParams::thesis()`), "grids" (`PlieParams::default()`) or "blockers-only"
+    /// (the thesis' parameters without regions).
     pub config: &'static str,
     pub seconds: f64,
     pub leaves: usize,
     pub records: usize,
+    pub records_removed_umbra: usize,
     pub blockers_mean: f64,
     pub blockers_max: u32,
 }
@@ -142,6 +144,10 @@ pub struct Shading {
     pub seconds: f64,
     pub rays: u64,
     pub triangle_tests_per_ray: f64,
+    /// Of `triangle_tests_per_ray`, the tests of P-LIE blockers (P-LIE modes; 0 in the others).
+    pub blocker_tests_per_ray: f64,
+    /// Of `triangle_tests_per_ray`, the tests of the ray's own leaf (P-LIE modes; 0 in the others).
+    pub own_leaf_tests_per_ray: f64,
     pub mrays_per_second: f64,
     pub mrays_per_second_per_core: f64,
 }
@@ -228,6 +234,7 @@ fn build_plie(
         seconds,
         leaves: s.leaves,
         records: s.records,
+        records_removed_umbra: s.records_removed_umbra,
         blockers_mean: s.blockers_mean,
         blockers_max: s.blockers_max,
     };
@@ -242,6 +249,8 @@ fn bench_scene(name: &str, plan: &Plan, one: &rayon::ThreadPool, bar: &Bar) -> R
     let (octree, octree_seconds) = timed(plan.runs, || Octree::build(&scene, thesis.octree()));
     let (lie, b1) = build_plie(&scene, &octree, thesis, "thesis", plan.runs);
     let (grid, b2) = build_plie(&scene, &octree, PlieParams::default(), "grids", plan.runs);
+    let no_regions = PlieParams { regions: false, ..thesis };
+    let (_, b3) = build_plie(&scene, &octree, no_regions, "blockers-only", plan.runs);
     bar.advance(1);
     let s = Structures { scene: &scene, bvh: &bvh, octree: &octree, lie: &lie, grid: &grid };
     let mut shading = Vec::new();
@@ -268,7 +277,7 @@ fn bench_scene(name: &str, plan: &Plan, one: &rayon::ThreadPool, bar: &Bar) -> R
         lights: scene.lights.len(),
         bvh_seconds,
         octree_seconds,
-        builds: vec![b1, b2],
+        builds: vec![b1, b2, b3],
         shading,
         break_even,
     })
@@ -302,6 +311,7 @@ fn time_shading(
     let ((_, stats), seconds) = timed(runs, || shade(scene, hits, vis, n, 0, &NoProgress));
     let threads = rayon::current_num_threads();
     let mrays = stats.shadow_rays as f64 / seconds.max(1e-9) / 1e6;
+    let per_ray = |n: u64| n as f64 / stats.shadow_rays.max(1) as f64;
     Shading {
         mode,
         size,
@@ -309,7 +319,9 @@ fn time_shading(
         threads,
         seconds,
         rays: stats.shadow_rays,
-        triangle_tests_per_ray: stats.triangle_tests as f64 / stats.shadow_rays.max(1) as f64,
+        triangle_tests_per_ray: per_ray(stats.triangle_tests),
+        blocker_tests_per_ray: per_ray(stats.blocker_tests),
+        own_leaf_tests_per_ray: per_ray(stats.own_leaf_tests),
         mrays_per_second: mrays,
         mrays_per_second_per_core: mrays / threads as f64,
     }

@@ -84,18 +84,19 @@ fn write_text(path: &Path, text: &str) -> Result<()> {
 
 /// One row per measurement: construction, then shading (all threads and 1 thread).
 fn csv(r: &Results) -> String {
-    let mut s = String::from(
-        "kind,scene,triangles,mode,size,shadow_rays,threads,seconds,rays,tests_per_ray,mrays_per_s,mrays_per_s_per_core\n",
-    );
+    let mut s = String::from(concat!(
+        "kind,scene,triangles,mode,size,shadow_rays,threads,seconds,rays,tests_per_ray,mrays_per_s,mrays_per_s_per_core,",
+        "blocker_tests_per_ray,own_leaf_tests_per_ray\n"
+    ));
     for sc in &r.scenes {
         for b in &sc.builds {
             let _ =
-                writeln!(s, "build,{},{},plie-{},,,{},{},,,,", sc.name, sc.triangles, b.config, r.threads, b.seconds);
+                writeln!(s, "build,{},{},plie-{},,,{},{},,,,,,", sc.name, sc.triangles, b.config, r.threads, b.seconds);
         }
         for x in &sc.shading {
             let _ = writeln!(
                 s,
-                "shading,{},{},{},{},{},{},{},{},{},{},{}",
+                "shading,{},{},{},{},{},{},{},{},{},{},{},{},{}",
                 sc.name,
                 sc.triangles,
                 x.mode,
@@ -106,7 +107,9 @@ fn csv(r: &Results) -> String {
                 x.rays,
                 x.triangle_tests_per_ray,
                 x.mrays_per_second,
-                x.mrays_per_second_per_core
+                x.mrays_per_second_per_core,
+                x.blocker_tests_per_ray,
+                x.own_leaf_tests_per_ray
             );
         }
     }
@@ -149,40 +152,39 @@ fn header(s: &mut String, plan: &Plan, r: &Results) {
         settings.join(" and "),
         rays.join(" and ")
     );
-    let _ = writeln!(
-        s,
-        "- not measured: refinement (thesis test 2, Table 8.2) and umbra/penumbra regions (modes c, d; \
-         Table 8.3 \"full\") are not implemented; our P-LIE holds blockers only, like Table 8.4.\n"
-    );
+    let _ = writeln!(s, "- not measured: refinement (thesis test 2, Table 8.2) is not implemented yet.\n");
 }
 
 fn construction(s: &mut String, r: &Results, th: Option<&Thesis>) {
     let _ = writeln!(s, "## Construction\n");
     let _ = writeln!(
         s,
-        "P-LIE construction alone (octree excluded), median seconds. `thesis`: 200 triangles per leaf, \
-         no refinement, no grids (test 1); `grids`: the same with face grids.\n"
+        "P-LIE construction alone (octree excluded), median seconds. `blockers only`: 200 triangles per \
+         leaf, no umbra/penumbra (Table 8.4); `regions`: with umbra/penumbra and removal of fully dark \
+         records (test 1, Table 8.3 \"full\"); `+ grids`: the same with face grids (mode grid).\n"
     );
-    let mut head = "| scene | triangles | lights | octree s | leaves | records | blockers/record (max) | thesis params s | grids s |".to_string();
-    let mut rule = "|---|---|---|---|---|---|---|---|---|".to_string();
+    let mut head = "| scene | triangles | lights | octree s | leaves | records (removed dark) | blockers/record (max) | blockers only s | regions s | + grids s |".to_string();
+    let mut rule = "|---|---|---|---|---|---|---|---|---|---|".to_string();
     if th.is_some() {
         head += " thesis 8.4 blockers-only s | thesis 8.3 full s (leaves) |";
         rule += "---|---|";
     }
     let _ = writeln!(s, "{head}\n{rule}");
     for sc in &r.scenes {
-        let (b, g) = (&sc.builds[0], &sc.builds[1]);
+        let (b, g, o) = (&sc.builds[0], &sc.builds[1], &sc.builds[2]);
         let _ = write!(
             s,
-            "| {} | {} | {} | {:.4} | {} | {} | {:.1} ({}) | {:.4} | {:.4} |",
+            "| {} | {} | {} | {:.4} | {} | {} ({}) | {:.1} ({}) | {:.4} | {:.4} | {:.4} |",
             sc.name,
             sc.triangles,
             sc.lights,
             sc.octree_seconds,
             b.leaves,
             b.records,
+            b.records_removed_umbra,
             b.blockers_mean,
             b.blockers_max,
+            o.seconds,
             b.seconds,
             g.seconds
         );
@@ -193,6 +195,8 @@ fn construction(s: &mut String, r: &Results, th: Option<&Thesis>) {
         }
         s.push('\n');
     }
+    let total = |i: usize| r.scenes.iter().map(|sc| sc.builds[i].seconds).sum::<f64>();
+    let _ = writeln!(s, "| **total** | | | | | | | **{:.3}** | **{:.3}** | **{:.3}** |", total(2), total(0), total(1));
     s.push('\n');
 }
 
@@ -213,9 +217,11 @@ fn shading(s: &mut String, plan: &Plan, r: &Results, th: Option<&Thesis>) {
                 let _ = write!(head, " {m} s |");
             }
             if th.is_some() {
-                head += " thesis OCTREE s | thesis LIE s |";
+                for m in THESIS_MODES {
+                    let _ = write!(head, " thesis {m} s |");
+                }
             }
-            let cols = plan.modes.len() + 1 + if th.is_some() { 2 } else { 0 };
+            let cols = plan.modes.len() + 1 + if th.is_some() { THESIS_MODES.len() } else { 0 };
             let _ = writeln!(s, "{head}\n|{}", "---|".repeat(cols));
             for sc in &r.scenes {
                 let _ = write!(s, "| {} |", sc.name);
@@ -223,9 +229,9 @@ fn shading(s: &mut String, plan: &Plan, r: &Results, th: Option<&Thesis>) {
                     let _ = write!(s, " {} |", fmt_opt(seconds(sc, m, size, rays, r.threads), 4));
                 }
                 if let Some(t) = th {
-                    let o = t.shading(&sc.name, "OCTREE", size, rays);
-                    let l = t.shading(&sc.name, "LIE", size, rays);
-                    let _ = write!(s, " {} | {} |", fmt_opt(o, 2), fmt_opt(l, 2));
+                    for m in THESIS_MODES {
+                        let _ = write!(s, " {} |", fmt_opt(t.shading(&sc.name, m, size, rays), 2));
+                    }
                 }
                 s.push('\n');
             }
@@ -233,6 +239,9 @@ fn shading(s: &mut String, plan: &Plan, r: &Results, th: Option<&Thesis>) {
         }
     }
 }
+
+/// The thesis' shading methods, modes (a)-(d).
+const THESIS_MODES: [&str; 4] = ["OCTREE", "LIE", "UMBRA", "PENUMBRA"];
 
 fn fmt_opt(x: Option<f64>, digits: usize) -> String {
     x.map(|v| format!("{v:.digits$}")).unwrap_or_default()
@@ -251,9 +260,9 @@ fn speed_ups(s: &mut String, plan: &Plan, r: &Results, th: Option<&Thesis>) {
         let _ = write!(head, " {m} |");
     }
     if th.is_some() {
-        head += " thesis LIE |";
+        head += " thesis LIE | thesis UMBRA | thesis PENUMBRA |";
     }
-    let cols = others.len() + 1 + usize::from(th.is_some());
+    let cols = others.len() + 1 + if th.is_some() { 3 } else { 0 };
     let _ = writeln!(s, "{head}\n|{}", "---|".repeat(cols));
     for &size in &plan.sizes {
         for &rays in &plan.shadow_rays {
@@ -264,16 +273,18 @@ fn speed_ups(s: &mut String, plan: &Plan, r: &Results, th: Option<&Thesis>) {
                 let _ = write!(s, " {:.1}% |", 100.0 * (1.0 - sum(m) / base));
             }
             if let Some(t) = th {
-                let pairs: Vec<(f64, f64)> = r
-                    .scenes
-                    .iter()
-                    .filter_map(|sc| {
-                        Some((t.shading(&sc.name, "OCTREE", size, rays)?, t.shading(&sc.name, "LIE", size, rays)?))
-                    })
-                    .collect();
-                let (o, l) = pairs.iter().fold((0.0, 0.0), |(a, b), (x, y)| (a + x, b + y));
-                let cell = if pairs.is_empty() { String::new() } else { format!("{:.1}%", 100.0 * (1.0 - l / o)) };
-                let _ = write!(s, " {cell} |");
+                for m in &THESIS_MODES[1..] {
+                    let pairs: Vec<(f64, f64)> = r
+                        .scenes
+                        .iter()
+                        .filter_map(|sc| {
+                            Some((t.shading(&sc.name, "OCTREE", size, rays)?, t.shading(&sc.name, m, size, rays)?))
+                        })
+                        .collect();
+                    let (o, l) = pairs.iter().fold((0.0, 0.0), |(a, b), (x, y)| (a + x, b + y));
+                    let cell = if pairs.is_empty() { String::new() } else { format!("{:.1}%", 100.0 * (1.0 - l / o)) };
+                    let _ = write!(s, " {cell} |");
+                }
             }
             s.push('\n');
         }

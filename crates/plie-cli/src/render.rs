@@ -9,7 +9,7 @@ use plie::octree::Octree;
 
 use plie::render::{render, RenderSettings};
 use plie::visibility::bvh::Bvh;
-use plie::visibility::{self, Mode};
+use plie::visibility::{self, Answer, Mode, QueryStats};
 use serde_json::json;
 
 use crate::plie_args::PlieArgs;
@@ -150,6 +150,11 @@ pub fn run(a: &Args) -> Result<()> {
             "triangle_tests_per_shadow_ray": per_ray,
             "box_tests": s.box_tests,
             "box_tests_per_shadow_ray": s.box_tests as f64 / s.shadow_rays.max(1) as f64,
+            "blocker_tests": s.blocker_tests,
+            "blocker_tests_per_shadow_ray": s.blocker_tests as f64 / s.shadow_rays.max(1) as f64,
+            "own_leaf_tests": s.own_leaf_tests,
+            "own_leaf_tests_per_shadow_ray": s.own_leaf_tests as f64 / s.shadow_rays.max(1) as f64,
+            "answers": s.answers,
             "shadow_rays_per_second": rays_per_second,
             "output": a.output.display().to_string(),
         });
@@ -186,9 +191,29 @@ pub fn run(a: &Args) -> Result<()> {
             rays_per_second / 1e6
         );
         eprintln!("triangle tests   {} ({per_ray:.2} per shadow ray)", s.triangle_tests);
+        print_answers(&s);
     }
     if !a.quiet && !a.json && !a.stats {
         eprintln!("wrote {} ({:.2} s shading, {} shadow rays)", a.output.display(), out.shading_seconds, s.shadow_rays);
     }
     Ok(())
+}
+
+/// The answer paths of a P-LIE mode (nothing for the other modes, which count none): rays and share of
+/// the shadow rays per path, and the triangle tests per shadow ray split into blockers and own leaf.
+fn print_answers(s: &QueryStats) {
+    if s.answers.total() == 0 {
+        return;
+    }
+    let per_ray = |n: u64| n as f64 / s.shadow_rays.max(1) as f64;
+    eprintln!(
+        "  of which       {:.2} blockers, {:.2} own leaf per shadow ray",
+        per_ray(s.blocker_tests),
+        per_ray(s.own_leaf_tests)
+    );
+    eprintln!("answered by      {:>12} {:>7}", "rays", "share");
+    for a in Answer::ALL {
+        let n = s.answers.get(a);
+        eprintln!("  {:<14} {n:>12} {:>6.1}%", a.name(), 100.0 * per_ray(n));
+    }
 }

@@ -92,6 +92,77 @@ fn render_writes_png_and_json() {
     assert_eq!(&bytes[1..4], b"PNG");
 }
 
+/// `plie render --json --stats` in `mode` on a small Cornell Cube 1: the JSON object and stderr.
+fn render_json_and_stats(dir: &Path, mode: &str) -> (serde_json::Value, String) {
+    let out = dir.join(format!("{mode}.png"));
+    let o = plie(&[
+        "render",
+        "--scene",
+        "cornell-cube-1",
+        "-o",
+        out.to_str().unwrap(),
+        "--width",
+        "20",
+        "--height",
+        "20",
+        "--eye-rays",
+        "1",
+        "--shadow-rays",
+        "3",
+        "--visibility",
+        mode,
+        "--json",
+        "--stats",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    (serde_json::from_slice(&o.stdout).expect("one JSON object on stdout"), stderr(&o))
+}
+
+const PATHS: [&str; 8] =
+    ["no_record", "umbra", "lit", "blockers_hit", "blockers_miss", "own_leaf", "inside_leaf", "outside_octree"];
+
+#[test]
+fn render_stats_and_json_report_how_shadow_rays_were_answered() {
+    let dir = tempfile::tempdir().unwrap();
+    let (bvh, bvh_stats) = render_json_and_stats(dir.path(), "bvh");
+    for mode in ["lie", "umbra", "penumbra", "grid"] {
+        let (v, stats) = render_json_and_stats(dir.path(), mode);
+        let n = |k: &str| v[k].as_u64().unwrap_or_else(|| panic!("{mode}: no count {k} in {v}"));
+        let answers = v["answers"].as_object().unwrap_or_else(|| panic!("{mode}: no answers object in {v}"));
+        assert_eq!(answers.len(), PATHS.len(), "{mode}: {v}");
+        let path = |k: &str| answers[k].as_u64().unwrap_or_else(|| panic!("{mode}: no path {k} in {v}"));
+        assert_eq!(PATHS.iter().map(|k| path(k)).sum::<u64>(), n("shadow_rays"), "{mode}: one path per ray: {v}");
+        let occluded: u64 = ["no_record", "umbra", "blockers_hit", "own_leaf"].iter().map(|k| path(k)).sum();
+        assert_eq!(occluded, n("occluded"), "{mode}: {v}");
+        assert!(path("blockers_hit") > 0, "{mode}: {v}");
+        assert_eq!(n("blocker_tests") + n("own_leaf_tests"), n("triangle_tests"), "{mode}: {v}");
+        let per_ray =
+            v["blocker_tests_per_shadow_ray"].as_f64().unwrap() + v["own_leaf_tests_per_shadow_ray"].as_f64().unwrap();
+        assert!((per_ray - v["triangle_tests_per_shadow_ray"].as_f64().unwrap()).abs() < 1e-9, "{mode}: {v}");
+        // Same image settings, exact modes: the same shadow rays and answers as bvh.
+        assert_eq!(
+            (n("shadow_rays"), n("occluded")),
+            (bvh["shadow_rays"].as_u64().unwrap(), bvh["occluded"].as_u64().unwrap())
+        );
+
+        assert!(stats.contains("answered by"), "{mode}: {stats}");
+        for k in PATHS {
+            let line = stats
+                .lines()
+                .find(|l| l.trim_start().starts_with(k))
+                .unwrap_or_else(|| panic!("{mode}: no {k} line: {stats}"));
+            let count: u64 = line.split_whitespace().nth(1).unwrap().parse().unwrap();
+            assert_eq!(count, path(k), "{mode}: {line}");
+            assert!(line.ends_with('%'), "{mode}: {line}");
+        }
+        assert!(stats.contains("blockers") && stats.contains("own leaf per shadow ray"), "{mode}: {stats}");
+    }
+    // Modes without a P-LIE count no paths: zeros in the JSON, no table.
+    assert!(bvh["answers"].as_object().unwrap().values().all(|x| x == 0), "{bvh}");
+    assert_eq!((bvh["blocker_tests"].as_u64(), bvh["own_leaf_tests"].as_u64()), (Some(0), Some(0)), "{bvh}");
+    assert!(!bvh_stats.contains("answered by"), "{bvh_stats}");
+}
+
 #[test]
 fn render_pfm_is_identical_for_every_mode() {
     let dir = tempfile::tempdir().unwrap();
@@ -273,7 +344,7 @@ fn bench_quick_writes_report_csv_json_and_chart() {
     assert!(o.status.success(), "{}", stderr(&o));
     let read = |name: &str| std::fs::read_to_string(out.join(name)).unwrap_or_else(|e| panic!("{name}: {e}"));
     let scenes = ["cornell-cube-1", "cornell-cube-3"];
-    let modes: Vec<&str> = ["octree", "bvh", "lie", "grid"].into();
+    let modes: Vec<&str> = ["octree", "bvh", "lie", "umbra", "penumbra", "grid"].into();
 
     let json: serde_json::Value = serde_json::from_str(&read("results.json")).expect("results.json parses");
     let names: Vec<&str> = json["scenes"].as_array().unwrap().iter().map(|s| s["name"].as_str().unwrap()).collect();
@@ -286,6 +357,14 @@ fn bench_quick_writes_report_csv_json_and_chart() {
     assert_eq!((header[scene_col], header[mode_col]), ("scene", "mode"));
     let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
     assert!(rows.iter().all(|r| r.len() == header.len()), "ragged CSV:\n{csv}");
+    let col = |name: &str| header.iter().position(|h| *h == name).unwrap_or_else(|| panic!("no {name}: {csv}"));
+    let (blocker_col, own_col) = (col("blocker_tests_per_ray"), col("own_leaf_tests_per_ray"));
+    for r in rows.iter().filter(|r| r[0] == "shading") {
+        let blocker: f64 = r[blocker_col].parse().unwrap();
+        let own: f64 = r[own_col].parse().unwrap();
+        let p_lie = ["lie", "umbra", "penumbra", "grid"].contains(&r[mode_col]);
+        assert_eq!(blocker > 0.0 && own > 0.0, p_lie, "test split of a {} row: {r:?}", r[mode_col]);
+    }
     for s in scenes {
         for m in &modes {
             assert!(

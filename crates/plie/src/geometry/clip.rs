@@ -14,7 +14,7 @@ pub fn clip3(poly: &mut Vec<DVec3>, n: DVec3, d: f64, tmp: &mut Vec<DVec3>) {
         if da <= 0.0 {
             tmp.push(a);
         }
-        if (da <= 0.0) != (db <= 0.0) {
+        if (da < 0.0 && db > 0.0) || (da > 0.0 && db < 0.0) {
             tmp.push(a + (b - a) * (da / (da - db)));
         }
     }
@@ -31,7 +31,7 @@ pub fn clip2(poly: &mut Vec<DVec2>, n: DVec2, d: f64, tmp: &mut Vec<DVec2>) {
         if da <= 0.0 {
             tmp.push(a);
         }
-        if (da <= 0.0) != (db <= 0.0) {
+        if (da < 0.0 && db > 0.0) || (da > 0.0 && db < 0.0) {
             tmp.push(a + (b - a) * (da / (da - db)));
         }
     }

@@ -105,7 +105,6 @@ pub fn shade(
         .map_init(
             || ShadeScratch::new(scene, shadow_rays),
             |s, (py, row)| {
-                let before = s.ctx.stats;
                 for (px, out) in row.iter_mut().enumerate() {
                     let pixel = py * w + px;
                     let mut sum = Vec3::ZERO;
@@ -117,12 +116,8 @@ pub fn shade(
                     *out = sum / per_pixel as f32;
                 }
                 progress.advance(1);
-                let mut delta = s.ctx.stats;
-                delta.shadow_rays -= before.shadow_rays;
-                delta.occluded -= before.occluded;
-                delta.triangle_tests -= before.triangle_tests;
-                delta.box_tests -= before.box_tests;
-                delta
+                // This row's counters; the scratch starts the next row from zero.
+                std::mem::take(&mut s.ctx.stats)
             },
         )
         .reduce(QueryStats::default, |mut a, b| {

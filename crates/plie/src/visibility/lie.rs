@@ -11,8 +11,11 @@
 //! Then the triangles of `c` itself (the part of the segment inside `c`). A segment that never leaves
 //! `c` only needs `c`'s triangles. Regions are conservative (see [`crate::construct::regions`]), so
 //! every mode answers exactly as the blocker test would.
+//!
+//! Each ray is counted on the [`Answer`] path that decided it, and its triangle tests are split into
+//! blocker tests and own-leaf tests (`plie render --stats`).
 
-use super::{blocks, Mode, OctreeVisibility, QueryCtx, ShadowRay, Visibility};
+use super::{blocks, Answer, Mode, OctreeVisibility, QueryCtx, ShadowRay, Visibility};
 use crate::construct::grid;
 use crate::construct::regions::{in_triangles, FaceFrame};
 use crate::geometry::{Aabb, Segment};
@@ -50,6 +53,15 @@ impl<'a> LieVisibility<'a> {
         ctx.stats.box_tests += 1;
         seg.clip(&self.tri_boxes[t.idx()]).is_some() && blocks(self.scene, ray, t, ctx)
     }
+
+    /// True if a triangle of `list` blocks the ray (tested in order, stopping at the first), and the
+    /// number of triangle tests that took.
+    #[inline]
+    fn any_blocks(&self, seg: &Segment, ray: &ShadowRay, list: &[TriId], ctx: &mut QueryCtx) -> (bool, u64) {
+        let before = ctx.stats.triangle_tests;
+        let hit = list.iter().any(|&t| self.test(seg, ray, t, ctx));
+        (hit, ctx.stats.triangle_tests - before)
+    }
 }
 
 /// The face through which the segment `ray` leaves the box of `leaf` and the segment parameter where
@@ -78,43 +90,59 @@ impl Visibility for LieVisibility<'_> {
     fn occluded(&self, ray: &ShadowRay, ctx: &mut QueryCtx) -> bool {
         let Some(leaf) = ray.leaf.or_else(|| self.octree.locate(ray.origin())) else {
             // Outside the octree: no environment to consult.
-            return OctreeVisibility::new(self.scene, self.octree).occluded(ray, ctx);
+            let hit = OctreeVisibility::new(self.scene, self.octree).occluded(ray, ctx);
+            return ctx.stats.answered(Answer::OutsideOctree, hit);
         };
         let seg = Segment::new(ray.test.origin, ray.test.dir, ray.test.t_min, ray.test.t_max);
-        if let Some((face, t_exit)) = exit_face(self.octree, leaf, ray) {
-            let Some(ri) = self.plie.record_id(leaf, face, ray.light) else {
-                return true;
-            };
-            let f = ray.test.origin + ray.test.dir * t_exit;
-            let record = || self.plie.blockers_of(&self.plie.records[ri]);
-            let list = match self.mode {
-                Mode::Umbra | Mode::Penumbra => {
-                    let x = FaceFrame::new(face, &self.octree.leaf_bounds(leaf)).units(f.as_dvec3());
-                    if in_triangles(self.plie.umbra_of(ri), x) {
-                        return true;
+        // The path the ray takes if the leaf's own triangles miss it.
+        let through = match exit_face(self.octree, leaf, ray) {
+            None => Answer::InsideLeaf,
+            Some((face, t_exit)) => {
+                let Some(ri) = self.plie.record_id(leaf, face, ray.light) else {
+                    return ctx.stats.answered(Answer::NoRecord, true);
+                };
+                let f = ray.test.origin + ray.test.dir * t_exit;
+                let record = || self.plie.blockers_of(&self.plie.records[ri]);
+                let list = match self.mode {
+                    Mode::Umbra | Mode::Penumbra => {
+                        let x = FaceFrame::new(face, &self.octree.leaf_bounds(leaf)).units(f.as_dvec3());
+                        if in_triangles(self.plie.umbra_of(ri), x) {
+                            return ctx.stats.answered(Answer::Umbra, true);
+                        }
+                        if self.mode == Mode::Penumbra && !in_triangles(self.plie.penumbra_of(ri), x) {
+                            &[]
+                        } else {
+                            record()
+                        }
                     }
-                    if self.mode == Mode::Penumbra && !in_triangles(self.plie.penumbra_of(ri), x) {
-                        &[]
-                    } else {
-                        record()
+                    Mode::Grid if self.plie.grids[ri].res > 0 => {
+                        let grid = &self.plie.grids[ri];
+                        let c = grid::cell_of(face, &self.octree.leaf_bounds(leaf), grid.res, f);
+                        match self.plie.cell(grid, c) {
+                            Cell::Umbra => return ctx.stats.answered(Answer::Umbra, true),
+                            Cell::Blockers(list) => list,
+                        }
                     }
-                }
-                Mode::Grid if self.plie.grids[ri].res > 0 => {
-                    let grid = &self.plie.grids[ri];
-                    let c = grid::cell_of(face, &self.octree.leaf_bounds(leaf), grid.res, f);
-                    match self.plie.cell(grid, c) {
-                        Cell::Umbra => return true,
-                        Cell::Blockers(list) => list,
+                    _ => record(),
+                };
+                if list.is_empty() {
+                    Answer::Lit
+                } else {
+                    let (hit, tests) = self.any_blocks(&seg, ray, list, ctx);
+                    ctx.stats.blocker_tests += tests;
+                    if hit {
+                        return ctx.stats.answered(Answer::BlockersHit, true);
                     }
-                }
-                _ => record(),
-            };
-            for &t in list {
-                if self.test(&seg, ray, t, ctx) {
-                    return true;
+                    Answer::BlockersMiss
                 }
             }
+        };
+        let (hit, tests) = self.any_blocks(&seg, ray, self.octree.leaf_triangles(leaf), ctx);
+        ctx.stats.own_leaf_tests += tests;
+        if hit {
+            ctx.stats.answered(Answer::OwnLeaf, true)
+        } else {
+            ctx.stats.answered(through, false)
         }
-        self.octree.leaf_triangles(leaf).iter().any(|&t| self.test(&seg, ray, t, ctx))
     }
 }

@@ -3,6 +3,7 @@
 //! which they do by testing candidates with the one shared [`blocks`] predicate and pruning only
 //! conservatively.
 
+pub mod answer;
 pub mod brute;
 pub mod bvh;
 #[cfg(feature = "embree")]
@@ -12,6 +13,7 @@ pub mod mode;
 pub mod octree;
 pub mod query;
 
+pub use answer::{Answer, Answers};
 pub use brute::Brute;
 pub use bvh::BvhVisibility;
 #[cfg(feature = "embree")]

@@ -4,6 +4,7 @@
 
 use glam::Vec3;
 
+use super::{Answer, Answers};
 use crate::geometry::RayTest;
 use crate::octree::LeafId;
 use crate::scene::{LightId, Scene, TriId};
@@ -54,6 +55,23 @@ pub struct QueryStats {
     pub triangle_tests: u64,
     /// Candidate bounding-box tests run before triangle tests (P-LIE modes).
     pub box_tests: u64,
+    /// Of `triangle_tests`, those of a record's (or grid cell's) blockers (P-LIE modes).
+    pub blocker_tests: u64,
+    /// Of `triangle_tests`, those of the triangles of the ray's own leaf (P-LIE modes).
+    pub own_leaf_tests: u64,
+    /// How the shadow rays were answered (P-LIE modes; zero in the others).
+    pub answers: Answers,
+}
+
+impl QueryStats {
+    /// Counts a ray decided by path `a` and returns its answer, `occluded`, so a mode can write
+    /// `return ctx.stats.answered(Answer::NoRecord, true)`.
+    #[inline]
+    pub fn answered(&mut self, a: Answer, occluded: bool) -> bool {
+        debug_assert!(a.occluded().is_none_or(|o| o == occluded), "{a:?} cannot answer {occluded}");
+        self.answers.count(a);
+        occluded
+    }
 }
 
 impl std::ops::AddAssign for QueryStats {
@@ -62,6 +80,9 @@ impl std::ops::AddAssign for QueryStats {
         self.occluded += o.occluded;
         self.triangle_tests += o.triangle_tests;
         self.box_tests += o.box_tests;
+        self.blocker_tests += o.blocker_tests;
+        self.own_leaf_tests += o.own_leaf_tests;
+        self.answers += o.answers;
     }
 }
 
