@@ -280,8 +280,12 @@ pub fn face_regions(
     // Projections from light vertices on or behind the face plane are unbounded: certify squares of
     // the face by the crossing test instead.
     if s.min_h <= 2.0 * s.guard {
-        let polys: Vec<Vec<DVec3>> =
-            blockers.iter().map(|t| scene.triangles[t.idx()].v.map(|p| p.as_dvec3()).to_vec()).chain(patches).collect();
+        let polys: Vec<Flat> = blockers
+            .iter()
+            .map(|t| scene.triangles[t.idx()].v.map(|p| p.as_dvec3()).to_vec())
+            .chain(patches)
+            .filter_map(|p| s.flat(p))
+            .collect();
         s.crossing_squares(&polys, DVec2::ZERO, UNITS, 0, &mut umbra, &mut core);
     }
     let mut out = FaceRegions { margin, umbra_blockers: umbra.len(), ..FaceRegions::default() };
@@ -613,7 +617,7 @@ impl Setup<'_> {
     /// [`Setup::crossing_blocks`].
     fn crossing_squares(
         &self,
-        polys: &[Vec<DVec3>],
+        polys: &[Flat],
         lo: DVec2,
         size: f64,
         depth: u32,
@@ -639,48 +643,67 @@ impl Setup<'_> {
         }
     }
 
-    /// True if every segment from the face square with corners `sq` to the light crosses the flat
-    /// convex blocker `poly` well inside it: square and light lie on opposite sides of its plane, at
-    /// least `guard` away, and the crossings of the segments between their corners (whose convex
-    /// hull holds every crossing) lie in `poly` shrunk by `r / cos + r`.
-    fn crossing_blocks(&self, poly: &[DVec3], sq: &[DVec3; 4]) -> bool {
-        let Some(mut n) = (poly[1] - poly[0]).cross(poly[2] - poly[0]).try_normalize() else {
-            return false;
-        };
+    /// A flat convex blocker prepared for [`Setup::crossing_blocks`]: `None` if degenerate or if the
+    /// light is not entirely at least `guard` in front of its plane.
+    fn flat(&self, poly: Vec<DVec3>) -> Option<Flat> {
+        let mut n = (poly[1] - poly[0]).cross(poly[2] - poly[0]).try_normalize()?;
         let o = poly[0];
         if n.dot(self.light[0].0 - o) < 0.0 {
             n = -n;
         }
-        let d = |p: DVec3| n.dot(p - o);
-        if self.light.iter().any(|&(v, _)| d(v) < self.guard) || sq.iter().any(|&c| d(c) > -self.guard) {
+        if self.light.iter().any(|&(v, _)| n.dot(v - o) < self.guard) {
+            return None;
+        }
+        let k = poly.len();
+        let centre = poly.iter().copied().sum::<DVec3>() / k as f64;
+        let edges = (0..k)
+            .map(|i| {
+                let (a, b) = (poly[i], poly[(i + 1) % k]);
+                let mut e = n.cross(b - a).normalize();
+                if e.dot(centre - a) < 0.0 {
+                    e = -e;
+                }
+                (e, e.dot(a))
+            })
+            .collect();
+        Some(Flat { n, o, edges })
+    }
+
+    /// True if every segment from the face square with corners `sq` to the light crosses the flat
+    /// convex blocker `f` well inside it: square and light lie on opposite sides of its plane, at
+    /// least `guard` away, and the crossings of the segments between their corners (whose convex
+    /// hull holds every crossing) lie in the blocker shrunk by `r / cos + r`.
+    fn crossing_blocks(&self, f: &Flat, sq: &[DVec3; 4]) -> bool {
+        let d = |p: DVec3| f.n.dot(p - f.o);
+        if sq.iter().any(|&c| d(c) > -self.guard) {
+            return false;
+        }
+        let crossing = |c: DVec3, v: DVec3| c + (v - c) * (d(c) / (d(c) - d(v)));
+        let inside = |g: DVec3, inset: f64| f.edges.iter().all(|&(e, ea)| e.dot(g) - ea >= inset);
+        // Cheap rejection first: one crossing, no inset.
+        if !inside(crossing(sq[0], self.light[0].0), 0.0) {
             return false;
         }
         let mut cos = f64::INFINITY;
         for &(v, _) in &self.light {
             for &c in sq {
-                cos = cos.min(n.dot((v - c).normalize()));
+                cos = cos.min(f.n.dot((v - c).normalize()));
             }
         }
         if cos < MIN_COS {
             return false;
         }
         let inset = self.r / cos + self.r;
-        let k = poly.len();
-        let centre = poly.iter().copied().sum::<DVec3>() / k as f64;
-        self.light.iter().all(|&(v, _)| {
-            sq.iter().all(|&c| {
-                let g = c + (v - c) * (d(c) / (d(c) - d(v)));
-                (0..k).all(|i| {
-                    let (a, b) = (poly[i], poly[(i + 1) % k]);
-                    let mut e = n.cross(b - a).normalize();
-                    if e.dot(centre - a) < 0.0 {
-                        e = -e;
-                    }
-                    (g - a).dot(e) >= inset
-                })
-            })
-        })
+        self.light.iter().all(|&(v, _)| sq.iter().all(|&c| inside(crossing(c, v), inset)))
     }
+}
+
+/// A flat convex blocker: plane normal `n` (toward the light) through `o`, and per edge the inward
+/// in-plane normal `e` with `e . a` for a point `a` of the edge.
+struct Flat {
+    n: DVec3,
+    o: DVec3,
+    edges: Vec<(DVec3, f64)>,
 }
 
 /// The axis-aligned square `[lo, hi]` as a counter-clockwise `f64` polygon.
