@@ -37,7 +37,8 @@ pub struct Args {
     #[arg(long, default_value_t = 25, value_name = "N")]
     shadow_rays: u32,
     /// Visibility method: brute (every triangle), octree (SPEC mode a), bvh (modern BVH), lie (P-LIE
-    /// blockers, SPEC mode b), embree (with the embree feature). All give the same image.
+    /// blockers, SPEC mode b), umbra (mode c), penumbra (mode d), grid (P-LIE face grids, ours),
+    /// embree (with the embree feature). All give the same image.
     #[arg(long, default_value = "bvh", value_name = "MODE")]
     visibility: Mode,
     /// Seed of the random streams (same seed, same image, in every exact mode).

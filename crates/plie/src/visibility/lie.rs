@@ -15,6 +15,7 @@
 //! Each ray is counted on the [`Answer`] path that decided it, and its triangle tests are split into
 //! blocker tests and own-leaf tests (`plie render --stats`).
 
+use super::leaf_voxels::LeafVoxels;
 use super::{blocks, Answer, Mode, OctreeVisibility, QueryCtx, ShadowRay, Visibility};
 use crate::construct::grid;
 use crate::construct::regions::{in_triangles, FaceFrame};
@@ -35,6 +36,8 @@ pub struct LieVisibility<'a> {
     tri_boxes: Vec<Aabb>,
     /// `Lie`, `Umbra`, `Penumbra` or `Grid`.
     mode: Mode,
+    /// Voxel grids over the leaves' own triangles.
+    voxels: LeafVoxels,
 }
 
 impl<'a> LieVisibility<'a> {
@@ -43,8 +46,9 @@ impl<'a> LieVisibility<'a> {
     /// test the blockers instead (still exact).
     pub fn new(scene: &'a Scene, octree: &'a Octree, plie: &'a Plie, mode: Mode) -> LieVisibility<'a> {
         let pad = scene.scale() * crate::construct::TOLERANCE_REL;
-        let tri_boxes = scene.triangles.iter().map(|t| t.aabb().expanded(pad)).collect();
-        LieVisibility { scene, octree, plie, tri_boxes, mode }
+        let tri_boxes: Vec<Aabb> = scene.triangles.iter().map(|t| t.aabb().expanded(pad)).collect();
+        let voxels = LeafVoxels::new(octree, &tri_boxes, pad);
+        LieVisibility { scene, octree, plie, tri_boxes, voxels, mode }
     }
 
     /// The box cull, then the shared predicate.
@@ -94,8 +98,9 @@ impl Visibility for LieVisibility<'_> {
             return ctx.stats.answered(Answer::OutsideOctree, hit);
         };
         let seg = Segment::new(ray.test.origin, ray.test.dir, ray.test.t_min, ray.test.t_max);
+        let exit = exit_face(self.octree, leaf, ray);
         // The path the ray takes if the leaf's own triangles miss it.
-        let through = match exit_face(self.octree, leaf, ray) {
+        let through = match exit {
             None => Answer::InsideLeaf,
             Some((face, t_exit)) => {
                 let Some(ri) = self.plie.record_id(leaf, face, ray.light) else {
@@ -137,8 +142,14 @@ impl Visibility for LieVisibility<'_> {
                 }
             }
         };
-        let (hit, tests) = self.any_blocks(&seg, ray, self.octree.leaf_triangles(leaf), ctx);
-        ctx.stats.own_leaf_tests += tests;
+        // The leaf's own triangles along the part of the segment inside the leaf.
+        let (o, d) = (ray.test.origin, ray.test.dir);
+        let t_end = exit.map_or(ray.test.t_max, |(_, t)| t.min(ray.test.t_max));
+        let part = (o + d * ray.test.t_min, o + d * t_end);
+        let before = ctx.stats.triangle_tests;
+        ctx.begin_query();
+        let hit = self.voxels.any(self.octree, leaf, &seg, part, ctx, |t, ctx| self.test(&seg, ray, t, ctx));
+        ctx.stats.own_leaf_tests += ctx.stats.triangle_tests - before;
         if hit {
             ctx.stats.answered(Answer::OwnLeaf, true)
         } else {

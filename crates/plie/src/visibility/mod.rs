@@ -8,6 +8,7 @@ pub mod brute;
 pub mod bvh;
 #[cfg(feature = "embree")]
 pub mod embree;
+pub mod leaf_voxels;
 pub mod lie;
 pub mod mode;
 pub mod octree;
