@@ -204,12 +204,14 @@ fn golden_parallel_plate_umbra_and_penumbra() {
     // by s = 9 / (9 - 4.5) = 2 about v: [2a - v, 2b - v] per axis. The umbra (intersection over v in
     // {0.4, 0.6}) is [2a - 0.4, 2b - 0.6], the shadow (hull) [2a - 0.6, 2b - 0.4], both clipped to [0, 1].
     let close = |x: f64, want: f64| (x - want).abs() < 0.005;
+    // Penumbra is rasterised conservatively on a 64 x 64 raster: up to a cell more on each side.
+    let covers = |x: f64, want: f64| x >= want - 0.005 && x <= want + 0.07;
     // [0.3, 0.7]: umbra [0.2, 0.8]² = 0.36, shadow [0, 1]², penumbra 0.64.
     let (u, p, full) = fractions((0.3, 0.7), 5.5);
-    assert!(close(u, 0.36) && close(p, 0.64) && !full, "{u} {p} {full}");
+    assert!(close(u, 0.36) && covers(p, 0.64) && !full, "{u} {p} {full}");
     // [0.45, 0.55]: no umbra ([0.5, 0.5]), shadow [0.3, 0.7]² = 0.16.
     let (u, p, full) = fractions((0.45, 0.55), 5.5);
-    assert!(u == 0.0 && close(p, 0.16) && !full, "{u} {p} {full}");
+    assert!(u == 0.0 && covers(p, 0.16) && !full, "{u} {p} {full}");
     // [0.15, 0.85]: umbra [-0.1, 1.1]² covers the face with room to spare: fully dark.
     let (_, _, full) = fractions((0.15, 0.85), 5.5);
     assert!(full);

@@ -8,7 +8,10 @@
 //!   a convex light and a convex blocker, every segment from a point of it to any point of the light
 //!   meets `T`. The face's umbra is the union over blockers.
 //! - **Shadow region of `T`** = convex hull of its projections: every face point from which some
-//!   segment to the light meets `T` lies in it. Penumbra = union of shadow regions minus umbra.
+//!   segment to the light meets `T` lies in it. Penumbra = union of shadow regions minus umbra. The
+//!   union is taken on a 64 x 64 raster of the face (every cell a shadow region meets), a superset
+//!   that is all the "lit" answer needs and far cheaper than exact booleans of thousands of
+//!   overlapping regions; the difference with the umbra is exact (i_overlay).
 //!
 //! **Exactness (SPEC §5).** A region decision must never disagree with the watertight test of the
 //! actual shadow ray `x -> y`, which crosses the face at `f`, counts hits for `t` in
@@ -212,7 +215,7 @@ struct Setup<'a> {
     light_pts: &'a [glam::Vec3],
     tol: f32,
     /// The sub-shafts of a `FALLBACK_RES²` grid on the face with their squares, made when needed.
-    cell_shafts: std::cell::OnceCell<Vec<(Shaft, IntContour<i32>)>>,
+    cell_shafts: std::cell::OnceCell<Vec<(Shaft, (u32, u32))>>,
 }
 
 /// The umbra and penumbra of the record (`face` of `cell`, `light`, `blockers`). `tol` is the
@@ -252,20 +255,20 @@ pub fn face_regions(
         cell_shafts: std::cell::OnceCell::new(),
     };
     let mut sc = Scratch::default();
-    let (mut umbra, mut core, mut shadow) = (Vec::new(), Vec::new(), Vec::new());
-    let mut whole_face_shadow = false;
+    let (mut umbra, mut core) = (Vec::new(), Vec::new());
+    let mut shadow = Raster::default();
     for &t in blockers {
         let tri = scene.triangles[t.idx()].v.map(|p| p.as_dvec3());
         if let Some((u, c)) = s.umbra_of(&tri, &mut sc) {
             umbra.push(u);
             core.extend(c);
         }
-        if !whole_face_shadow {
+        if !shadow.full() {
             match s.shadow_of(&tri, &mut sc) {
                 Shadow::None => {}
-                Shadow::Whole => whole_face_shadow = true,
-                Shadow::Polygon(p) => shadow.push(p),
-                Shadow::Cells(c) => shadow.extend(c),
+                Shadow::Whole => shadow.mark_all(),
+                Shadow::Polygon => shadow.mark_polygon(&sc.a, &mut sc.tmp2, &mut sc.b),
+                Shadow::Cells(c) => c.into_iter().for_each(|(i, j)| shadow.mark_fallback_cell(i, j)),
             }
         }
     }
@@ -289,7 +292,7 @@ pub fn face_regions(
         s.crossing_squares(&polys, DVec2::ZERO, UNITS, 0, &mut umbra, &mut core);
     }
     let mut out = FaceRegions { margin, umbra_blockers: umbra.len(), ..FaceRegions::default() };
-    if umbra.is_empty() && shadow.is_empty() && !whole_face_shadow {
+    if umbra.is_empty() && shadow.is_empty() {
         return out;
     }
     let face_sq = square(DVec2::splat(-margin), DVec2::splat(UNITS + margin));
@@ -303,8 +306,7 @@ pub fn face_regions(
             return out;
         }
     }
-    let shadow = if whole_face_shadow { vec![vec![face_sq]] } else { union(shadow) };
-    let shadow_shapes = difference(&shadow, &union(core));
+    let shadow_shapes = difference(&shadow.rectangles(margin), &union(core));
     let face_area = UNITS * UNITS;
     out.umbra_fraction = (area(&out.umbra_shapes) / face_area).min(1.0);
     out.penumbra_fraction = (area(&shadow_shapes) / face_area).min(1.0);
@@ -320,11 +322,115 @@ enum Shadow {
     None,
     /// Projections are unbounded: the whole face.
     Whole,
-    /// A convex polygon (units).
-    Polygon(IntContour<i32>),
-    /// Squares of face-grid cells whose sub-shafts the blocker meets (when projections from the
+    /// A convex polygon (units), left in the scratch buffer `a`.
+    Polygon,
+    /// The fallback grid's cells whose sub-shafts the blocker meets (when projections from the
     /// light's vertices do not bound it).
-    Cells(Vec<IntContour<i32>>),
+    Cells(Vec<(u32, u32)>),
+}
+
+/// Cells per side of the raster that unites the shadow regions.
+const RASTER: usize = 64;
+
+/// The union of the shadow regions as a `RASTER x RASTER` bitmap of face cells, each set when a
+/// shadow region meets it: a superset of the union, which is all "lit" needs (a point outside every
+/// set cell is outside every shadow region), and far cheaper than exact booleans of thousands of
+/// overlapping regions. The outermost cells stand for everything beyond the face's edges too.
+#[derive(Default)]
+struct Raster {
+    rows: Vec<u64>,
+    set: usize,
+}
+
+impl Raster {
+    fn ensure(&mut self) {
+        if self.rows.is_empty() {
+            self.rows = vec![0; RASTER];
+        }
+    }
+
+    fn is_empty(&self) -> bool {
+        self.set == 0
+    }
+
+    fn full(&self) -> bool {
+        self.set == RASTER * RASTER
+    }
+
+    fn mark(&mut self, j: usize, i0: usize, i1: usize) {
+        self.ensure();
+        let bits = if i1 - i0 + 1 == 64 { u64::MAX } else { ((1u64 << (i1 - i0 + 1)) - 1) << i0 };
+        self.set += (bits & !self.rows[j]).count_ones() as usize;
+        self.rows[j] |= bits;
+    }
+
+    fn mark_all(&mut self) {
+        for j in 0..RASTER {
+            self.mark(j, 0, RASTER - 1);
+        }
+    }
+
+    /// Marks the cells of fallback-grid cell `(i, j)`.
+    fn mark_fallback_cell(&mut self, i: u32, j: u32) {
+        let k = RASTER / FALLBACK_RES as usize;
+        for row in j as usize * k..(j as usize + 1) * k {
+            self.mark(row, i as usize * k, (i as usize + 1) * k - 1);
+        }
+    }
+
+    /// Marks every cell the convex polygon `poly` (units) meets: per row, the polygon clipped to the
+    /// row's slab gives the range of columns.
+    fn mark_polygon(&mut self, poly: &[DVec2], tmp: &mut Vec<DVec2>, row: &mut Vec<DVec2>) {
+        let w = UNITS / RASTER as f64;
+        let cell = |x: f64| ((x / w).floor().max(0.0) as usize).min(RASTER - 1);
+        let (y_lo, y_hi) = poly.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), p| (a.min(p.y), b.max(p.y)));
+        if poly.is_empty() {
+            return;
+        }
+        for j in cell(y_lo)..=cell(y_hi) {
+            row.clear();
+            row.extend_from_slice(poly);
+            if j > 0 {
+                clip2(row, DVec2::NEG_Y, -(j as f64 * w), tmp);
+            }
+            if j + 1 < RASTER {
+                clip2(row, DVec2::Y, (j + 1) as f64 * w, tmp);
+            }
+            if row.is_empty() {
+                continue;
+            }
+            let (x_lo, x_hi) =
+                row.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), p| (a.min(p.x), b.max(p.x)));
+            self.mark(j, cell(x_lo), cell(x_hi));
+        }
+    }
+
+    /// The set cells as rectangles (runs of each row), the outermost grown by `2 * margin` beyond the
+    /// face's edges.
+    fn rectangles(&self, margin: f64) -> IntShapes<i32> {
+        let w = UNITS / RASTER as f64;
+        let edge = |k: usize| match k {
+            0 => -2.0 * margin,
+            RASTER => UNITS + 2.0 * margin,
+            _ => k as f64 * w,
+        };
+        let mut out = Vec::new();
+        for (j, &bits) in self.rows.iter().enumerate() {
+            let mut i = 0;
+            while i < RASTER {
+                if bits >> i & 1 == 0 {
+                    i += 1;
+                    continue;
+                }
+                let start = i;
+                while i < RASTER && bits >> i & 1 == 1 {
+                    i += 1;
+                }
+                out.push(vec![square(DVec2::new(edge(start), edge(j)), DVec2::new(edge(i), edge(j + 1)))]);
+            }
+        }
+        out
+    }
 }
 
 /// Cells per side of the grid used when a blocker's shadow cannot be bounded by projections.
@@ -451,11 +557,10 @@ impl Setup<'_> {
         for (n, dd) in [(DVec2::X, hi), (DVec2::NEG_X, -lo), (DVec2::Y, hi), (DVec2::NEG_Y, -lo)] {
             clip2(&mut s.a, n, dd, &mut s.tmp2);
         }
-        match snap(&s.a) {
-            Some(c) => Shadow::Polygon(c),
-            None if s.a.is_empty() => Shadow::None,
-            // Dilated by at least two units, a non-empty region never snaps to nothing; be safe anyway.
-            None => Shadow::Whole,
+        if s.a.is_empty() {
+            Shadow::None
+        } else {
+            Shadow::Polygon
         }
     }
 }
@@ -579,24 +684,22 @@ impl Setup<'_> {
     fn cells_shadow(&self, tri: &[DVec3; 3]) -> Shadow {
         let cells = self.cell_shafts.get_or_init(|| {
             let g = FALLBACK_RES;
-            let w = UNITS / g as f64;
             let mut out = Vec::with_capacity((g * g) as usize);
             for j in 0..g {
                 for i in 0..g {
                     let b = super::grid::cell_box(self.face, self.cell, g, i, j);
                     let shaft = Shaft::new(&self.face.face_corners(&b), self.light_pts, self.tol);
-                    let lo = DVec2::new(i as f64 * w, j as f64 * w);
-                    out.push((shaft, square(lo - self.margin, lo + w + self.margin)));
+                    out.push((shaft, (i, j)));
                 }
             }
             out
         });
         let t = tri.map(|p| p.as_vec3());
         let bounds = Aabb::from_points(t.iter());
-        let hit: Vec<IntContour<i32>> = cells
+        let hit: Vec<(u32, u32)> = cells
             .iter()
             .filter(|(sh, _)| sh.bounds.overlaps(&bounds) && sh.clips_triangle(&t))
-            .map(|(_, sq)| sq.clone())
+            .map(|&(_, ij)| ij)
             .collect();
         if hit.len() == cells.len() {
             Shadow::Whole
