@@ -848,7 +848,7 @@ fn contour_area2(c: &[IntPoint<i32>]) -> i64 {
 }
 
 /// The union of convex contours, merged pairwise: each overlay then only meets the boundaries of two
-/// partial unions, not every edge crossing inside the final union (shadow regions overlap a lot).
+/// partial unions, not every edge crossing inside the final union (umbra regions overlap a lot).
 fn union(contours: Vec<IntContour<i32>>) -> IntShapes<i32> {
     let mut parts: Vec<IntShapes<i32>> = contours.into_iter().map(|c| vec![vec![c]]).collect();
     while parts.len() > 1 {
