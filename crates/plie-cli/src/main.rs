@@ -6,6 +6,7 @@ mod bench;
 mod bench_chart;
 mod bench_report;
 mod build;
+mod inspect;
 mod plie_args;
 mod progress;
 mod render;
@@ -30,6 +31,8 @@ enum Command {
     Render(Box<render::Args>),
     /// Build the P-LIE of a scene and save it (.plie).
     Build(Box<build::Args>),
+    /// Show what the P-LIE stores for a cell: a picture, a glTF scene, or a per-leaf summary.
+    Inspect(Box<inspect::Args>),
     /// Measure construction, shading and throughput per scene and mode (the thesis' protocol).
     Bench(Box<bench::Args>),
 }
@@ -40,6 +43,7 @@ fn main() {
         Command::Scenes(a) => scenes::run(&a),
         Command::Render(a) => render::run(&a),
         Command::Build(a) => build::run(&a),
+        Command::Inspect(a) => inspect::run(&a),
         Command::Bench(a) => bench::run(&a),
     };
     if let Err(e) = result {

@@ -32,6 +32,13 @@ use shaft::Shaft;
 /// Relative tolerance of the construction (times the scene size): every test errs toward keeping.
 pub const TOLERANCE_REL: f32 = 1e-5;
 
+/// The absolute tolerance of the construction for `scene` over `octree`: [`TOLERANCE_REL`] times the
+/// larger of the scene's size and the octree's root cube. Every test that must agree with the builder
+/// (e.g. `plie inspect` telling a removed record from a face that cannot see the light) uses this.
+pub fn tolerance(scene: &Scene, octree: &Octree) -> f32 {
+    scene.scale().max(octree.root_bounds().size().max_element()) * TOLERANCE_REL
+}
+
 /// Named counters and stage times of one construction.
 #[derive(Clone, Debug, Default, PartialEq, Serialize)]
 pub struct BuildStats {
@@ -101,7 +108,7 @@ struct LeafRecords {
 /// Builds the P-LIE of `scene` over `octree` (stages 1-3).
 pub fn build(scene: &Scene, octree: &Octree, params: PlieParams, progress: &dyn Progress) -> (Plie, BuildStats) {
     let t0 = Instant::now();
-    let tol = scene.scale().max(octree.root_bounds().size().max_element()) * TOLERANCE_REL;
+    let tol = tolerance(scene, octree);
     let lights = scene.lights.len();
     progress.start("blockers", octree.leaf_count() as u64);
     let abs_scale = octree.root_bounds().min.abs().max(octree.root_bounds().max.abs()).max_element();

@@ -4,6 +4,7 @@
 //! - [`load_scene`] picks the loader by extension: [`obj::load_obj`], [`gltf::load_gltf`]. Both turn
 //!   emissive triangles into convex polygonal lights with [`lights`].
 //! - [`save_image`] writes radiance; [`load_pfm`] reads a PFM back for bit-exact comparisons.
+//! - [`gltf_export::save_inspection_gltf`] writes what `plie inspect` shows as a glTF scene.
 //! - [`write_atomic`] is the only way files are written: a temporary file, fsync, rename.
 //!
 //! Every error names the file and, where the format has lines, the line. Loaders never panic on input;
@@ -11,6 +12,7 @@
 
 pub mod atomic;
 pub mod gltf;
+pub mod gltf_export;
 pub mod image;
 pub mod lights;
 pub mod obj;
