@@ -123,13 +123,14 @@ pub struct SceneResult {
 /// One P-LIE construction (median seconds of the construction alone, octree excluded).
 #[derive(Serialize)]
 pub struct BuildResult {
-    /// "thesis" (`PlieParams::thesis()`), "grids" (`PlieParams::default()`) or "blockers-only"
-    /// (the thesis' parameters without regions).
+    /// "thesis" (`PlieParams::thesis()`), "grids" (`PlieParams::default()`), "blockers-only" (the
+    /// thesis' parameters without regions) or "no-propagation" (the thesis' without propagation).
     pub config: &'static str,
     pub seconds: f64,
     pub leaves: usize,
     pub records: usize,
     pub records_removed_umbra: usize,
+    pub records_removed_propagation: usize,
     pub blockers_mean: f64,
     pub blockers_max: u32,
 }
@@ -235,6 +236,7 @@ fn build_plie(
         leaves: s.leaves,
         records: s.records,
         records_removed_umbra: s.records_removed_umbra,
+        records_removed_propagation: s.records_removed_propagation,
         blockers_mean: s.blockers_mean,
         blockers_max: s.blockers_max,
     };
@@ -251,6 +253,8 @@ fn bench_scene(name: &str, plan: &Plan, one: &rayon::ThreadPool, bar: &Bar) -> R
     let (grid, b2) = build_plie(&scene, &octree, PlieParams::default(), "grids", plan.runs);
     let no_regions = PlieParams { regions: false, ..thesis };
     let (_, b3) = build_plie(&scene, &octree, no_regions, "blockers-only", plan.runs);
+    let no_propagation = PlieParams { propagation: false, ..thesis };
+    let (_, b4) = build_plie(&scene, &octree, no_propagation, "no-propagation", plan.runs);
     bar.advance(1);
     let s = Structures { scene: &scene, bvh: &bvh, octree: &octree, lie: &lie, grid: &grid };
     let mut shading = Vec::new();
@@ -277,7 +281,7 @@ fn bench_scene(name: &str, plan: &Plan, one: &rayon::ThreadPool, bar: &Bar) -> R
         lights: scene.lights.len(),
         bvh_seconds,
         octree_seconds,
-        builds: vec![b1, b2, b3],
+        builds: vec![b1, b2, b3, b4],
         shading,
         break_even,
     })

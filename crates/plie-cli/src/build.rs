@@ -51,6 +51,16 @@ pub fn run(a: &Args) -> Result<()> {
     let write_seconds = t.elapsed().as_secs_f64();
     let memory = plie.memory_bytes() + octree.memory_bytes();
     if a.json {
+        let propagation = json!({
+            "enabled": params.propagation,
+            "records_removed": stats.records_removed_propagation,
+            "tests": stats.propagation_tests,
+            "by_rule": stats.propagation_by_rule,
+            "waves": stats.propagation_waves,
+            "seconds": stats.propagation_seconds,
+            "record_seconds_mean": stats.record_seconds_mean,
+            "seconds_saved_estimate": stats.propagation_seconds_saved_estimate,
+        });
         let v = json!({
             "scene": scene.name,
             "triangles": scene.triangle_count(),
@@ -73,6 +83,8 @@ pub fn run(a: &Args) -> Result<()> {
             "blockers_max": stats.blockers_max,
             "regions": params.regions,
             "records_removed_umbra": stats.records_removed_umbra,
+            "records_removed_propagation": stats.records_removed_propagation,
+            "propagation": propagation,
             "records_with_umbra": stats.records_with_umbra,
             "records_with_penumbra": stats.records_with_penumbra,
             "region_polygon_vertices": stats.region_polygon_vertices,
@@ -124,6 +136,28 @@ pub fn run(a: &Args) -> Result<()> {
                 stats.region_polygon_vertices,
                 stats.region_triangles,
                 stats.region_bytes
+            );
+        }
+        if !params.regions {
+        } else if !params.propagation {
+            println!("propagation     none (--no-propagation)");
+        } else {
+            println!(
+                "propagation     {} records removed without computing their blockers ({} of {} candidates proven; {} waves, {:.3} s propagating)",
+                stats.records_removed_propagation,
+                stats.records_removed_propagation,
+                stats.propagation_tests,
+                stats.propagation_waves,
+                stats.propagation_seconds
+            );
+            if stats.records_removed_propagation > 0 {
+                let rules: Vec<String> = stats.propagation_by_rule.iter().map(|(r, n)| format!("{n} {r}")).collect();
+                println!("                by rule: {}", rules.join(", "));
+            }
+            println!(
+                "                time saved ≈ {:.3} s (estimate: {:.2} ms per record computed, over the threads, minus propagation)",
+                stats.propagation_seconds_saved_estimate,
+                1e3 * stats.record_seconds_mean
             );
         }
         if !params.grids {

@@ -1,4 +1,4 @@
-//! `--max-triangles`, `--max-depth`, `--no-grids` and `--no-regions`: the P-LIE build parameters
+//! `--max-triangles`, `--max-depth`, `--no-grids`, `--no-regions` and `--no-propagation`: the P-LIE build parameters
 //! (SPEC §4.9) shared by `plie build` and `plie render`.
 
 use anyhow::Result;
@@ -21,6 +21,10 @@ pub struct PlieArgs {
     /// in the thesis' Table 8.4. Modes `umbra` and `penumbra` need them.
     #[arg(long)]
     pub no_regions: bool,
+    /// P-LIE: do not propagate umbra to neighbouring cells (SPEC §4.7); every record's blockers are
+    /// computed. Same records except fully dark ones; only construction time changes.
+    #[arg(long)]
+    pub no_propagation: bool,
 }
 
 impl PlieArgs {
@@ -31,6 +35,7 @@ impl PlieArgs {
             max_depth: self.max_depth,
             grids: want_grids && !self.no_grids,
             regions: !self.no_regions,
+            propagation: !self.no_propagation,
         };
         p.octree().validate()?;
         Ok(p)

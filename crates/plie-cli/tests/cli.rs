@@ -278,6 +278,33 @@ fn build_then_render_with_the_saved_p_lie() {
 }
 
 #[test]
+fn build_reports_propagation_and_no_propagation_turns_it_off() {
+    let dir = tempfile::tempdir().unwrap();
+    let f = dir.path().join("h.plie");
+    let base = ["build", "--scene", "huis-a", "--max-triangles", "24", "-o", f.to_str().unwrap()];
+    let json = |extra: &[&str]| {
+        let o = plie(&[&base[..], extra, &["--json"]].concat());
+        assert!(o.status.success(), "{}", stderr(&o));
+        serde_json::from_slice::<serde_json::Value>(&o.stdout).expect("one JSON object")
+    };
+    let on = json(&[]);
+    let off = json(&["--no-propagation"]);
+    let removed = on["propagation"]["records_removed"].as_u64().unwrap();
+    assert!(removed > 0, "{on}");
+    assert_eq!(on["records_removed_propagation"].as_u64(), Some(removed));
+    assert_eq!(off["propagation"]["enabled"], false);
+    assert_eq!(off["propagation"]["records_removed"].as_u64(), Some(0));
+    // Propagation only deletes fully dark records: as many or fewer records, none added.
+    let records = |v: &serde_json::Value| v["records"].as_u64().unwrap();
+    assert!(records(&on) <= records(&off));
+    let o = plie(&base);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert!(text.contains(&format!("propagation     {removed} records removed")), "{text}");
+    assert!(text.contains("time saved"), "{text}");
+}
+
+#[test]
 fn bad_scene_files_give_one_line_errors() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();

@@ -7,16 +7,21 @@
 //! 4. [`regions`]: umbra and penumbra on the face (§4.5); a record fully in umbra is removed (§4.6).
 //! 5. [`grid`]: per record, a face grid of per-cell blocker lists with its umbra cells marked (our
 //!    addition, SPEC §8 points 2-4).
+//! 6. [`propagation`]: faces proven dark by a dark neighbour lose their record before stages 2-5 run
+//!    for them (§4.7).
 //!
-//! Propagation (§4.7) and refinement (§4.8) come later.
-//! Leaves are processed in parallel with rayon; the result does not depend on the thread count.
+//! Refinement (§4.8) comes later. The (leaf, light) tasks run in waves ([`propagation::waves`]), each
+//! wave in parallel with rayon, then propagation from it; the result does not depend on the thread
+//! count.
 
 pub mod blockers;
 pub mod data_objects;
 pub mod grid;
+pub mod propagation;
 pub mod regions;
 pub mod shaft;
 
+use std::collections::BTreeMap;
 use std::time::Instant;
 
 use rayon::prelude::*;
@@ -27,6 +32,7 @@ use crate::octree::{Dir, LeafId, Octree};
 use crate::render::Progress;
 use crate::scene::{LightId, Scene, TriId};
 use blockers::{gather_blockers, GatherScratch};
+use propagation::{FaceState, FaceStates, Propagated, Propagator, Tolerances};
 use shaft::Shaft;
 
 /// Relative tolerance of the construction (times the scene size): every test errs toward keeping.
@@ -60,6 +66,22 @@ pub struct BuildStats {
     pub blockers_max: u32,
     /// Records removed because their face lies fully in umbra (§4.6).
     pub records_removed_umbra: usize,
+    /// Records deleted by propagation (§4.7) without computing their blockers.
+    pub records_removed_propagation: usize,
+    /// Of those, how many each rule proposed ([`propagation::Rule::name`]).
+    pub propagation_by_rule: BTreeMap<&'static str, usize>,
+    /// Principle tests run by propagation (pending candidates proposed by the rules).
+    pub propagation_tests: usize,
+    /// Construction waves (1 without propagation).
+    pub propagation_waves: usize,
+    /// Seconds spent propagating (between waves, on one thread).
+    pub propagation_seconds: f64,
+    /// Mean thread-seconds to compute one record (blockers, regions, grid), fully dark ones included.
+    pub record_seconds_mean: f64,
+    /// Estimated wall seconds propagation saved: the records it deleted times the mean record time,
+    /// over the threads, minus the propagation time. An estimate; measure with and without
+    /// propagation for the real figure (`plie bench`).
+    pub propagation_seconds_saved_estimate: f64,
     /// Records (kept) with some umbra.
     pub records_with_umbra: usize,
     /// Records (kept) with some penumbra.
@@ -84,52 +106,118 @@ pub struct BuildStats {
     pub grid_cells: usize,
     /// Seconds building the octree.
     pub octree_seconds: f64,
-    /// Seconds computing data objects, shafts, blockers, regions and grids.
+    /// Seconds computing data objects, shafts, blockers, regions and grids, propagation included.
     pub blockers_seconds: f64,
 }
 
 /// One record before flattening.
 struct PendingRecord {
-    face: Dir,
-    light: LightId,
     blockers: Vec<TriId>,
     regions: Option<regions::FaceRegions>,
     grid: Option<grid::PendingGrid>,
 }
 
-/// The records of one leaf before flattening, and its counters.
+/// What one (leaf, light) task computed: a record per face, the faces' new states, counters.
 #[derive(Default)]
-struct LeafRecords {
-    records: Vec<PendingRecord>,
+struct TaskRecords {
+    records: [Option<PendingRecord>; 6],
+    computed: [Option<FaceState>; 6],
     candidates: usize,
     removed_umbra: usize,
+    seconds: f64,
 }
 
-/// Builds the P-LIE of `scene` over `octree` (stages 1-3).
+/// The P-LIE, its statistics, and the records propagation deleted.
+pub struct Built {
+    /// The P-LIE.
+    pub plie: Plie,
+    /// Its statistics.
+    pub stats: BuildStats,
+    /// The records deleted by propagation, in the order they were.
+    pub propagated: Vec<Propagated>,
+}
+
+/// Builds the P-LIE of `scene` over `octree` (stages 1-6).
 pub fn build(scene: &Scene, octree: &Octree, params: PlieParams, progress: &dyn Progress) -> (Plie, BuildStats) {
+    let b = build_traced(scene, octree, params, progress);
+    (b.plie, b.stats)
+}
+
+/// [`build`], also returning which records propagation deleted (for tests and reports).
+pub fn build_traced(scene: &Scene, octree: &Octree, params: PlieParams, progress: &dyn Progress) -> Built {
     let t0 = Instant::now();
     let tol = tolerance(scene, octree);
     let lights = scene.lights.len();
-    progress.start("blockers", octree.leaf_count() as u64);
     let abs_scale = octree.root_bounds().min.abs().max(octree.root_bounds().max.abs()).max_element();
-    let per_leaf: Vec<LeafRecords> = (0..octree.leaf_count() as u32)
-        .into_par_iter()
-        .map_init(
-            || GatherScratch::new(scene.triangles.len()),
-            |scratch, l| {
-                let r = leaf_records(scene, octree, LeafId(l), tol, abs_scale, params, scratch);
-                progress.advance(1);
-                r
-            },
-        )
-        .collect();
+    let tols = Tolerances::new(tol, abs_scale);
+    let propagate = params.propagation && params.regions;
+    let waves = propagation::waves(scene, octree, propagate);
+    let mut states = FaceStates::new(scene, octree, tol);
+    let mut propagator = Propagator::new(scene, octree, tols);
+    let mut tasks: Vec<TaskRecords> = (0..octree.leaf_count() * lights).map(|_| TaskRecords::default()).collect();
+    let mut propagation_seconds = 0.0;
+    progress.start("blockers", (octree.leaf_count() * lights) as u64);
+    for wave in &waves {
+        let frozen = &states;
+        let done: Vec<TaskRecords> = wave
+            .par_iter()
+            .map_init(
+                || GatherScratch::new(scene.triangles.len()),
+                |scratch, &(leaf, light)| {
+                    let r = task_records(scene, octree, (leaf, light), frozen, &tols, abs_scale, params, scratch);
+                    progress.advance(1);
+                    r
+                },
+            )
+            .collect();
+        for (&(leaf, light), r) in wave.iter().zip(done) {
+            for (face, s) in Dir::ALL.into_iter().zip(r.computed) {
+                if let Some(s) = s {
+                    states.set(leaf, face, light, s);
+                }
+            }
+            tasks[leaf.idx() * lights + light.idx()] = r;
+        }
+        if propagate {
+            let t = Instant::now();
+            propagator.after_wave(&mut states, wave);
+            propagation_seconds += t.elapsed().as_secs_f64();
+        }
+    }
     progress.finish();
 
     let mut stats = BuildStats {
         leaves: octree.leaf_count(),
         faces_considered: octree.leaf_count() * 6 * lights,
+        propagation_waves: waves.len(),
+        propagation_seconds,
         ..Default::default()
     };
+    let plie = flatten(octree, params, lights, tasks, &mut stats);
+    stats.propagation_tests = propagator.tests;
+    let propagated = propagator.log;
+    stats.records_removed_propagation = propagated.len();
+    debug_assert_eq!(propagated.len(), states.propagated());
+    for p in &propagated {
+        *stats.propagation_by_rule.entry(p.rule.name()).or_default() += 1;
+    }
+    stats.no_record_face_cannot_see_light =
+        stats.faces_considered - stats.records - stats.records_removed_umbra - stats.records_removed_propagation;
+    let threads = rayon::current_num_threads().max(1) as f64;
+    stats.propagation_seconds_saved_estimate =
+        stats.records_removed_propagation as f64 * stats.record_seconds_mean / threads - propagation_seconds;
+    stats.blockers_seconds = t0.elapsed().as_secs_f64();
+    Built { plie, stats, propagated }
+}
+
+/// The tasks' records flattened into the P-LIE (by leaf, face, light), with their statistics.
+fn flatten(
+    octree: &Octree,
+    params: PlieParams,
+    lights: usize,
+    mut tasks: Vec<TaskRecords>,
+    stats: &mut BuildStats,
+) -> Plie {
     let mut plie = Plie {
         params,
         leaves: octree.leaf_count() as u32,
@@ -143,42 +231,51 @@ pub fn build(scene: &Scene, octree: &Octree, params: PlieParams, progress: &dyn 
         regions: Vec::new(),
         region_tris: Vec::new(),
     };
+    let (mut task_seconds, mut computed) = (0.0, 0);
+    for t in &tasks {
+        stats.candidates_clipped += t.candidates;
+        stats.records_removed_umbra += t.removed_umbra;
+        task_seconds += t.seconds;
+        computed += t.computed.iter().flatten().count();
+    }
+    stats.record_seconds_mean = if computed > 0 { task_seconds / computed as f64 } else { 0.0 };
     let (mut umbra_sum, mut penumbra_sum) = (0.0, 0.0);
-    for (l, leaf) in per_leaf.into_iter().enumerate() {
-        stats.candidates_clipped += leaf.candidates;
-        stats.records_removed_umbra += leaf.removed_umbra;
-        for rec in leaf.records {
-            let fg = flatten_grid(rec.grid, &mut plie, &mut stats);
-            plie.grids.push(fg);
-            let mut rr = RecordRegions::default();
-            if let Some(reg) = rec.regions {
-                stats.records_with_umbra += !reg.umbra.is_empty() as usize;
-                stats.records_with_penumbra += !reg.penumbra.is_empty() as usize;
-                stats.region_polygon_vertices += reg.polygon_vertices;
-                umbra_sum += reg.umbra_fraction;
-                penumbra_sum += reg.penumbra_fraction;
-                rr.umbra_start = plie.region_tris.len() as u32;
-                rr.umbra_len = reg.umbra.len() as u32;
-                plie.region_tris.extend(reg.umbra);
-                rr.penumbra_start = plie.region_tris.len() as u32;
-                rr.penumbra_len = reg.penumbra.len() as u32;
-                plie.region_tris.extend(reg.penumbra);
+    for leaf in octree.leaves() {
+        for face in Dir::ALL {
+            for li in 0..lights {
+                let Some(rec) = tasks[leaf.idx() * lights + li].records[face.index()].take() else { continue };
+                let fg = flatten_grid(rec.grid, &mut plie, stats);
+                plie.grids.push(fg);
+                let mut rr = RecordRegions::default();
+                if let Some(reg) = rec.regions {
+                    stats.records_with_umbra += !reg.umbra.is_empty() as usize;
+                    stats.records_with_penumbra += !reg.penumbra.is_empty() as usize;
+                    stats.region_polygon_vertices += reg.polygon_vertices;
+                    umbra_sum += reg.umbra_fraction;
+                    penumbra_sum += reg.penumbra_fraction;
+                    rr.umbra_start = plie.region_tris.len() as u32;
+                    rr.umbra_len = reg.umbra.len() as u32;
+                    plie.region_tris.extend(reg.umbra);
+                    rr.penumbra_start = plie.region_tris.len() as u32;
+                    rr.penumbra_len = reg.penumbra.len() as u32;
+                    plie.region_tris.extend(reg.penumbra);
+                }
+                plie.regions.push(rr);
+                let light = LightId(li as u32);
+                let i = plie.slot(leaf, face, light);
+                plie.record_index[i] = plie.records.len() as u32;
+                plie.records.push(Record {
+                    leaf,
+                    face,
+                    light,
+                    blockers_start: plie.blockers.len() as u32,
+                    blockers_len: rec.blockers.len() as u32,
+                });
+                plie.blockers.extend(rec.blockers);
             }
-            plie.regions.push(rr);
-            let i = plie.slot(LeafId(l as u32), rec.face, rec.light);
-            plie.record_index[i] = plie.records.len() as u32;
-            plie.records.push(Record {
-                leaf: LeafId(l as u32),
-                face: rec.face,
-                light: rec.light,
-                blockers_start: plie.blockers.len() as u32,
-                blockers_len: rec.blockers.len() as u32,
-            });
-            plie.blockers.extend(rec.blockers);
         }
     }
     stats.records = plie.records.len();
-    stats.no_record_face_cannot_see_light = stats.faces_considered - stats.records - stats.records_removed_umbra;
     stats.region_triangles = plie.region_tris.len();
     stats.region_bytes = plie.region_tris.len() * std::mem::size_of::<regions::Tri2>()
         + plie.regions.len() * std::mem::size_of::<RecordRegions>();
@@ -188,8 +285,7 @@ pub fn build(scene: &Scene, octree: &Octree, params: PlieParams, progress: &dyn 
     }
     stats.blockers_total = plie.blockers.len();
     (stats.blockers_mean, stats.blockers_max) = plie.blocker_stats();
-    stats.blockers_seconds = t0.elapsed().as_secs_f64();
-    (plie, stats)
+    plie
 }
 
 /// A record's grid, flattened into `plie.cells` and `plie.cell_blockers`.
@@ -218,47 +314,53 @@ fn flatten_grid(grid: Option<grid::PendingGrid>, plie: &mut Plie, stats: &mut Bu
     fg
 }
 
-/// Every stage for one leaf: every face and light.
-fn leaf_records(
+/// Stages 2-5 for one (leaf, light): every face still `Pending` (faces propagation deleted are
+/// skipped, and so are faces that cannot see the light).
+#[allow(clippy::too_many_arguments)]
+fn task_records(
     scene: &Scene,
     octree: &Octree,
-    leaf: LeafId,
-    tol: f32,
+    (leaf, light_id): (LeafId, LightId),
+    states: &FaceStates,
+    tols: &Tolerances,
     abs_scale: f32,
     params: PlieParams,
     scratch: &mut GatherScratch,
-) -> LeafRecords {
+) -> TaskRecords {
+    let t0 = Instant::now();
+    let tol = tols.tol;
     let b = octree.leaf_bounds(leaf);
-    let mut out = LeafRecords::default();
+    let light = &scene.lights[light_id.idx()];
+    let mut out = TaskRecords::default();
     for face in Dir::ALL {
-        let corners = face.face_corners(&b);
-        for (li, light) in scene.lights.iter().enumerate() {
-            if !data_objects::face_sees_light(&corners, face.normal(), light, tol) {
-                continue;
-            }
-            let shaft = Shaft::new(&corners, &light.vertices, tol);
-            let mut blockers = Vec::new();
-            let light_id = LightId(li as u32);
-            out.candidates += gather_blockers(scene, octree, &shaft, light_id, scratch, &mut blockers);
-            let regions = params
-                .regions
-                .then(|| regions::face_regions(scene, face, &b, light, &blockers, &shaft, tol, abs_scale));
-            if regions.as_ref().is_some_and(|r| r.full_umbra) {
-                out.removed_umbra += 1;
-                continue;
-            }
-            let has_umbra = regions.as_ref().is_some_and(|r| !r.umbra.is_empty());
-            let mut grid = if params.grids {
-                let min_res = if has_umbra { grid::UMBRA_MIN_RES } else { 0 };
-                grid::face_grid(scene, face, &b, light, &blockers, tol, min_res)
-            } else {
-                None
-            };
-            if let (Some(g), Some(reg)) = (grid.as_mut(), regions.as_ref().filter(|_| has_umbra)) {
-                g.umbra = grid::umbra_cells(g.g, reg);
-            }
-            out.records.push(PendingRecord { face, light: light_id, blockers, regions, grid });
+        if states.get(leaf, face, light_id) != FaceState::Pending {
+            continue;
         }
+        let corners = face.face_corners(&b);
+        let shaft = Shaft::new(&corners, &light.vertices, tol);
+        let mut blockers = Vec::new();
+        out.candidates += gather_blockers(scene, octree, &shaft, light_id, scratch, &mut blockers);
+        let regions =
+            params.regions.then(|| regions::face_regions(scene, face, &b, light, &blockers, &shaft, tol, abs_scale));
+        if let Some(reg) = regions.as_ref().filter(|r| r.full_umbra) {
+            out.removed_umbra += 1;
+            let budget = propagation::dark_budget(face, &b, light, reg, tols);
+            out.computed[face.index()] = Some(FaceState::Dark { budget });
+            continue;
+        }
+        let has_umbra = regions.as_ref().is_some_and(|r| !r.umbra.is_empty());
+        let mut grid = if params.grids {
+            let min_res = if has_umbra { grid::UMBRA_MIN_RES } else { 0 };
+            grid::face_grid(scene, face, &b, light, &blockers, tol, min_res)
+        } else {
+            None
+        };
+        if let (Some(g), Some(reg)) = (grid.as_mut(), regions.as_ref().filter(|_| has_umbra)) {
+            g.umbra = grid::umbra_cells(g.g, reg);
+        }
+        out.records[face.index()] = Some(PendingRecord { blockers, regions, grid });
+        out.computed[face.index()] = Some(FaceState::Kept);
     }
+    out.seconds = t0.elapsed().as_secs_f64();
     out
 }

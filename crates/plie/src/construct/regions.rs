@@ -144,6 +144,13 @@ impl FaceFrame {
     }
 }
 
+/// The error bound `r` (world units) the regions are built with: above `f32` rounding of the scene's
+/// coordinates (`abs_scale` is the largest absolute coordinate) and at least the construction
+/// tolerance `tol`.
+pub fn error_bound(tol: f32, abs_scale: f32) -> f64 {
+    (tol as f64).max(abs_scale as f64 * 1e-5)
+}
+
 /// Umbra and penumbra of one record, triangulated in its face's units.
 #[derive(Clone, Debug, Default)]
 pub struct FaceRegions {
@@ -161,6 +168,16 @@ pub struct FaceRegions {
     pub polygon_vertices: usize,
     /// Blockers that contribute umbra.
     pub umbra_blockers: usize,
+    /// Lowest and highest height above the face (world units) of the blocker geometry that casts the
+    /// umbra: a segment from an umbra point to the light is blocked between these heights. `None` when
+    /// some umbra comes from the crossing test (a light vertex near the face plane) or there is none.
+    /// Used to certify propagation (see [`crate::construct::propagation`]).
+    pub hit_heights: Option<(f64, f64)>,
+    /// Height above the face plane of the light's lowest vertex (world units).
+    pub min_light_height: f64,
+    /// The margin by which the face is grown before it is compared with the umbra, in world units: a
+    /// fully dark face is dark on the face grown by this much in its plane.
+    pub margin_world: f64,
     umbra_shapes: IntShapes<i32>,
     margin: f64,
 }
@@ -236,7 +253,7 @@ pub fn face_regions(
     let min_h = lv.iter().map(|p| p.1).fold(f64::INFINITY, f64::min);
     let all = Aabb::from_points(face.face_corners(cell).iter().chain(&light.vertices));
     let diag = all.size().as_dvec3().length();
-    let r = (tol as f64).max(abs_scale as f64 * 1e-5);
+    let r = error_bound(tol, abs_scale);
     let margin = r * frame.q + 2.0;
     let s = Setup {
         frame,
@@ -257,11 +274,16 @@ pub fn face_regions(
     let mut sc = Scratch::default();
     let (mut umbra, mut core) = (Vec::new(), Vec::new());
     let mut shadow = Raster::default();
+    let mut heights = (f64::INFINITY, f64::NEG_INFINITY);
+    let mut add = |(u, c, h): Umbra, umbra: &mut Vec<IntContour<i32>>, core: &mut Vec<IntContour<i32>>| {
+        umbra.push(u);
+        core.extend(c);
+        heights = (heights.0.min(h.0), heights.1.max(h.1));
+    };
     for &t in blockers {
         let tri = scene.triangles[t.idx()].v.map(|p| p.as_dvec3());
-        if let Some((u, c)) = s.umbra_of(&tri, &mut sc) {
-            umbra.push(u);
-            core.extend(c);
+        if let Some(u) = s.umbra_of(&tri, &mut sc) {
+            add(u, &mut umbra, &mut core);
         }
         if !shadow.full() {
             match s.shadow_of(&tri, &mut sc) {
@@ -275,11 +297,11 @@ pub fn face_regions(
     // Fused blockers (SPEC §8 point 2): flat convex patches of several triangles.
     let patches = fused_patches(scene, blockers, s.r);
     for patch in &patches {
-        if let Some((u, c)) = s.umbra_of(patch, &mut sc) {
-            umbra.push(u);
-            core.extend(c);
+        if let Some(u) = s.umbra_of(patch, &mut sc) {
+            add(u, &mut umbra, &mut core);
         }
     }
+    let projected = umbra.len();
     // Projections from light vertices on or behind the face plane are unbounded: certify squares of
     // the face by the crossing test instead.
     if s.min_h <= 2.0 * s.guard {
@@ -291,7 +313,14 @@ pub fn face_regions(
             .collect();
         s.crossing_squares(&polys, DVec2::ZERO, UNITS, 0, &mut umbra, &mut core);
     }
-    let mut out = FaceRegions { margin, umbra_blockers: umbra.len(), ..FaceRegions::default() };
+    let mut out = FaceRegions {
+        margin,
+        umbra_blockers: umbra.len(),
+        hit_heights: (projected > 0 && umbra.len() == projected).then_some(heights),
+        min_light_height: s.min_h,
+        margin_world: margin / s.frame.scale(),
+        ..FaceRegions::default()
+    };
     if umbra.is_empty() && shadow.is_empty() {
         return out;
     }
@@ -433,12 +462,16 @@ impl Raster {
     }
 }
 
+/// One blocker's umbra, its core, and the height range of the blocker part casting it.
+type Umbra = (IntContour<i32>, Option<IntContour<i32>>, (f64, f64));
+
 /// Cells per side of the grid used when a blocker's shadow cannot be bounded by projections.
 const FALLBACK_RES: u32 = 8;
 
 impl Setup<'_> {
-    /// The umbra of one blocker and its core (both eroded, snapped, counter-clockwise), if any.
-    fn umbra_of(&self, tri: &[DVec3], s: &mut Scratch) -> Option<(IntContour<i32>, Option<IntContour<i32>>)> {
+    /// The umbra of one blocker and its core (both eroded, snapped, counter-clockwise), if any, with
+    /// the lowest and highest height of the part of the blocker that casts it.
+    fn umbra_of(&self, tri: &[DVec3], s: &mut Scratch) -> Option<Umbra> {
         let n = (tri[1] - tri[0]).cross(tri[2] - tri[0]).try_normalize()?;
         if self.min_h <= 2.0 * self.guard {
             return None;
@@ -481,6 +514,10 @@ impl Setup<'_> {
         if s.poly.len() < 3 {
             return None;
         }
+        let heights = s.poly.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &p| {
+            let h = self.frame.height(p);
+            (lo.min(h), hi.max(h))
+        });
         let lo = DVec2::splat(-3.0 * self.margin);
         let hi = DVec2::splat(UNITS + 3.0 * self.margin);
         s.a.clear();
@@ -511,7 +548,7 @@ impl Setup<'_> {
             }
         }
         let umbra = snap(&s.a)?;
-        Some((umbra, snap(&s.b)))
+        Some((umbra, snap(&s.b), heights))
     }
 
     /// The shadow region of one blocker (dilated, snapped, counter-clockwise).

@@ -28,14 +28,25 @@ pub struct PlieParams {
     /// Compute umbra and penumbra (SPEC §4.5) and remove fully dark records (§4.6). The thesis' Table
     /// 8.4 measured construction without them.
     pub regions: bool,
+    /// Propagate umbra to neighbouring cells (SPEC §4.7, thesis chapter 6): delete the records of
+    /// faces proven dark by a fully dark neighbour without computing their blockers. Only speeds up
+    /// construction; needs `regions` (without them no face is known to be dark).
+    pub propagation: bool,
 }
 
 impl PlieParams {
     /// The thesis' test 1: 200 triangles per leaf, umbra and penumbra, no refinement, nothing the
-    /// thesis did not have.
+    /// thesis did not have. Propagation is on: the thesis' construction always removes data by
+    /// umbra and propagates it (§5.7, chapter 6); test 1 only turned refinement off (§8.2.1).
     pub fn thesis() -> PlieParams {
         let o = crate::octree::OctreeParams::thesis();
-        PlieParams { max_triangles: o.max_triangles, max_depth: o.max_depth, grids: false, regions: true }
+        PlieParams {
+            max_triangles: o.max_triangles,
+            max_depth: o.max_depth,
+            grids: false,
+            regions: true,
+            propagation: true,
+        }
     }
 
     /// The octree part of the parameters.

@@ -96,6 +96,18 @@ impl Light {
         v[0] + (v[i + 1] - v[0]) * b1 + (v[i + 2] - v[0]) * b2
     }
 
+    /// Points whose convex hull holds every point [`Light::sample`] returns, up to `f32` rounding: the
+    /// vertices, and for a parallelogram (sampled by the bilinear map, which the test above accepts up
+    /// to a small deviation) also `v1 + v3 - v0`.
+    pub fn sample_domain(&self) -> Vec<Vec3> {
+        let v = &self.vertices;
+        let mut out = v.clone();
+        if self.parallelogram {
+            out.push(v[1] + v[3] - v[0]);
+        }
+        out
+    }
+
     /// Centroid of the vertices.
     pub fn center(&self) -> Vec3 {
         self.vertices.iter().copied().sum::<Vec3>() / self.vertices.len() as f32
