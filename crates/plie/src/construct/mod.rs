@@ -150,6 +150,9 @@ pub fn build_traced(scene: &Scene, octree: &Octree, params: PlieParams, progress
     let mut propagator = Propagator::new(scene, octree, tols);
     let mut tasks: Vec<TaskRecords> = (0..octree.leaf_count() * lights).map(|_| TaskRecords::default()).collect();
     let (mut propagation_seconds, mut wave_count, mut found_dark) = (0.0, 0, false);
+    let scratches: Vec<std::sync::Mutex<GatherScratch>> = (0..rayon::current_num_threads().max(1))
+        .map(|_| std::sync::Mutex::new(GatherScratch::new(scene.triangles.len())))
+        .collect();
     progress.start("blockers", order.len() as u64);
     while let Some(range) = waves.next(found_dark) {
         let wave = &order[range];
@@ -167,10 +170,12 @@ pub fn build_traced(scene: &Scene, octree: &Octree, params: PlieParams, progress
             .collect();
         let done: Vec<FaceOut> = items
             .par_iter()
-            .map_init(
-                || GatherScratch::new(scene.triangles.len()),
-                |scratch, &(i, face)| face_record(scene, octree, wave[i], face, &tols, abs_scale, params, scratch),
-            )
+            .map(|&(i, face)| {
+                // One scratch per worker thread, kept across waves (an item never waits for another).
+                let slot = &scratches[rayon::current_thread_index().unwrap_or(0) % scratches.len()];
+                let mut scratch = slot.lock().unwrap_or_else(|e| e.into_inner());
+                face_record(scene, octree, wave[i], face, &tols, abs_scale, params, &mut scratch)
+            })
             .collect();
         found_dark = false;
         for (&(i, face), out) in items.iter().zip(done) {
