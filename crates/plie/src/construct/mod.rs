@@ -10,7 +10,7 @@
 //! 6. [`propagation`]: faces proven dark by a dark neighbour lose their record before stages 2-5 run
 //!    for them (§4.7).
 //!
-//! Refinement (§4.8) comes later. The (leaf, light) tasks run in waves ([`propagation::waves`]), each
+//! Refinement (§4.8) comes later. The (leaf, light) tasks run in waves ([`propagation::Waves`]), each
 //! wave in parallel with rayon, then propagation from it; the result does not depend on the thread
 //! count.
 
@@ -117,7 +117,7 @@ struct PendingRecord {
     grid: Option<grid::PendingGrid>,
 }
 
-/// What one (leaf, light) task computed: a record per face, the faces' new states, counters.
+/// What was computed for one (leaf, light): a record per face, the faces' new states, counters.
 #[derive(Default)]
 struct TaskRecords {
     records: [Option<PendingRecord>; 6],
@@ -151,33 +151,52 @@ pub fn build_traced(scene: &Scene, octree: &Octree, params: PlieParams, progress
     let abs_scale = octree.root_bounds().min.abs().max(octree.root_bounds().max.abs()).max_element();
     let tols = Tolerances::new(tol, abs_scale);
     let propagate = params.propagation && params.regions;
-    let waves = propagation::waves(scene, octree, propagate);
+    let order = propagation::task_order(scene, octree, propagate);
+    let mut waves = propagation::Waves::new(order.len(), propagate);
     let mut states = FaceStates::new(scene, octree, tol);
     let mut propagator = Propagator::new(scene, octree, tols);
     let mut tasks: Vec<TaskRecords> = (0..octree.leaf_count() * lights).map(|_| TaskRecords::default()).collect();
-    let mut propagation_seconds = 0.0;
-    progress.start("blockers", (octree.leaf_count() * lights) as u64);
-    for wave in &waves {
+    let (mut propagation_seconds, mut wave_count, mut found_dark) = (0.0, 0, false);
+    let scratches: Vec<std::sync::Mutex<GatherScratch>> = (0..rayon::current_num_threads().max(1))
+        .map(|_| std::sync::Mutex::new(GatherScratch::new(scene.triangles.len())))
+        .collect();
+    progress.start("blockers", order.len() as u64);
+    while let Some(range) = waves.next(found_dark) {
+        let wave = &order[range];
+        wave_count += 1;
+        // Every face still pending in the wave, one parallel item each (finer than a (leaf, light)
+        // task, so a wave's slowest item is short).
         let frozen = &states;
-        let done: Vec<TaskRecords> = wave
-            .par_iter()
-            .map_init(
-                || GatherScratch::new(scene.triangles.len()),
-                |scratch, &(leaf, light)| {
-                    let r = task_records(scene, octree, (leaf, light), frozen, &tols, abs_scale, params, scratch);
-                    progress.advance(1);
-                    r
-                },
-            )
+        let items: Vec<(usize, Dir)> = wave
+            .iter()
+            .enumerate()
+            .flat_map(|(i, &(leaf, light))| {
+                let pending = Dir::ALL.into_iter().filter(move |&f| frozen.get(leaf, f, light) == FaceState::Pending);
+                pending.map(move |f| (i, f))
+            })
             .collect();
-        for (&(leaf, light), r) in wave.iter().zip(done) {
-            for (face, s) in Dir::ALL.into_iter().zip(r.computed) {
-                if let Some(s) = s {
-                    states.set(leaf, face, light, s);
-                }
-            }
-            tasks[leaf.idx() * lights + light.idx()] = r;
+        let done: Vec<FaceOut> = items
+            .par_iter()
+            .map(|&(i, face)| {
+                // One scratch per worker thread, kept across waves (an item never waits for another).
+                let slot = &scratches[rayon::current_thread_index().unwrap_or(0) % scratches.len()];
+                let mut scratch = slot.lock().unwrap_or_else(|e| e.into_inner());
+                face_record(scene, octree, wave[i], face, &tols, abs_scale, params, &mut scratch)
+            })
+            .collect();
+        found_dark = false;
+        for (&(i, face), out) in items.iter().zip(done) {
+            let (leaf, light) = wave[i];
+            found_dark |= out.state.vouches().is_some();
+            states.set(leaf, face, light, out.state);
+            let t = &mut tasks[leaf.idx() * lights + light.idx()];
+            t.records[face.index()] = out.record;
+            t.computed[face.index()] = Some(out.state);
+            t.candidates += out.candidates;
+            t.removed_umbra += matches!(out.state, FaceState::Dark { .. }) as usize;
+            t.seconds += out.seconds;
         }
+        progress.advance(wave.len() as u64);
         if propagate {
             let t = Instant::now();
             propagator.after_wave(&mut states, wave);
@@ -189,7 +208,7 @@ pub fn build_traced(scene: &Scene, octree: &Octree, params: PlieParams, progress
     let mut stats = BuildStats {
         leaves: octree.leaf_count(),
         faces_considered: octree.leaf_count() * 6 * lights,
-        propagation_waves: waves.len(),
+        propagation_waves: wave_count,
         propagation_seconds,
         ..Default::default()
     };
@@ -314,40 +333,39 @@ fn flatten_grid(grid: Option<grid::PendingGrid>, plie: &mut Plie, stats: &mut Bu
     fg
 }
 
-/// Stages 2-5 for one (leaf, light): every face still `Pending` (faces propagation deleted are
-/// skipped, and so are faces that cannot see the light).
+/// What stages 2-5 made of one (leaf, face, light).
+struct FaceOut {
+    record: Option<PendingRecord>,
+    state: FaceState,
+    candidates: usize,
+    seconds: f64,
+}
+
+/// Stages 2-5 for one (leaf, face, light) that is still `Pending`.
 #[allow(clippy::too_many_arguments)]
-fn task_records(
+fn face_record(
     scene: &Scene,
     octree: &Octree,
     (leaf, light_id): (LeafId, LightId),
-    states: &FaceStates,
+    face: Dir,
     tols: &Tolerances,
     abs_scale: f32,
     params: PlieParams,
     scratch: &mut GatherScratch,
-) -> TaskRecords {
+) -> FaceOut {
     let t0 = Instant::now();
     let tol = tols.tol;
     let b = octree.leaf_bounds(leaf);
     let light = &scene.lights[light_id.idx()];
-    let mut out = TaskRecords::default();
-    for face in Dir::ALL {
-        if states.get(leaf, face, light_id) != FaceState::Pending {
-            continue;
-        }
-        let corners = face.face_corners(&b);
-        let shaft = Shaft::new(&corners, &light.vertices, tol);
-        let mut blockers = Vec::new();
-        out.candidates += gather_blockers(scene, octree, &shaft, light_id, scratch, &mut blockers);
-        let regions =
-            params.regions.then(|| regions::face_regions(scene, face, &b, light, &blockers, &shaft, tol, abs_scale));
-        if let Some(reg) = regions.as_ref().filter(|r| r.full_umbra) {
-            out.removed_umbra += 1;
-            let budget = propagation::dark_budget(face, &b, light, reg, tols);
-            out.computed[face.index()] = Some(FaceState::Dark { budget });
-            continue;
-        }
+    let corners = face.face_corners(&b);
+    let shaft = Shaft::new(&corners, &light.vertices, tol);
+    let mut blockers = Vec::new();
+    let candidates = gather_blockers(scene, octree, &shaft, light_id, scratch, &mut blockers);
+    let regions =
+        params.regions.then(|| regions::face_regions(scene, face, &b, light, &blockers, &shaft, tol, abs_scale));
+    let (record, state) = if let Some(reg) = regions.as_ref().filter(|r| r.full_umbra) {
+        (None, FaceState::Dark { budget: propagation::dark_budget(face, &b, light, reg, tols) })
+    } else {
         let has_umbra = regions.as_ref().is_some_and(|r| !r.umbra.is_empty());
         let mut grid = if params.grids {
             let min_res = if has_umbra { grid::UMBRA_MIN_RES } else { 0 };
@@ -358,9 +376,7 @@ fn task_records(
         if let (Some(g), Some(reg)) = (grid.as_mut(), regions.as_ref().filter(|_| has_umbra)) {
             g.umbra = grid::umbra_cells(g.g, reg);
         }
-        out.records[face.index()] = Some(PendingRecord { blockers, regions, grid });
-        out.computed[face.index()] = Some(FaceState::Kept);
-    }
-    out.seconds = t0.elapsed().as_secs_f64();
-    out
+        (Some(PendingRecord { blockers, regions, grid }), FaceState::Kept)
+    };
+    FaceOut { record, state, candidates, seconds: t0.elapsed().as_secs_f64() }
 }
