@@ -4,13 +4,17 @@
 
 use glam::{DVec2, DVec3};
 
-/// Keeps the part of the convex polygon `poly` with `n . p <= d`, using `tmp` as scratch.
-pub fn clip3(poly: &mut Vec<DVec3>, n: DVec3, d: f64, tmp: &mut Vec<DVec3>) {
+/// Keeps the part of the convex polygon `poly` where `dist(p) <= 0`, for an affine `dist` (the signed
+/// distance to a plane or line), using `tmp` as scratch.
+fn clip_by<P>(poly: &mut Vec<P>, dist: impl Fn(P) -> f64, tmp: &mut Vec<P>)
+where
+    P: Copy + std::ops::Add<Output = P> + std::ops::Sub<Output = P> + std::ops::Mul<f64, Output = P>,
+{
     tmp.clear();
     let len = poly.len();
     for i in 0..len {
         let (a, b) = (poly[i], poly[(i + 1) % len]);
-        let (da, db) = (n.dot(a) - d, n.dot(b) - d);
+        let (da, db) = (dist(a), dist(b));
         if da <= 0.0 {
             tmp.push(a);
         }
@@ -22,20 +26,13 @@ pub fn clip3(poly: &mut Vec<DVec3>, n: DVec3, d: f64, tmp: &mut Vec<DVec3>) {
 }
 
 /// Keeps the part of the convex polygon `poly` with `n . p <= d`, using `tmp` as scratch.
+pub fn clip3(poly: &mut Vec<DVec3>, n: DVec3, d: f64, tmp: &mut Vec<DVec3>) {
+    clip_by(poly, |p| n.dot(p) - d, tmp);
+}
+
+/// Keeps the part of the convex polygon `poly` with `n . p <= d`, using `tmp` as scratch.
 pub fn clip2(poly: &mut Vec<DVec2>, n: DVec2, d: f64, tmp: &mut Vec<DVec2>) {
-    tmp.clear();
-    let len = poly.len();
-    for i in 0..len {
-        let (a, b) = (poly[i], poly[(i + 1) % len]);
-        let (da, db) = (n.dot(a) - d, n.dot(b) - d);
-        if da <= 0.0 {
-            tmp.push(a);
-        }
-        if (da < 0.0 && db > 0.0) || (da > 0.0 && db < 0.0) {
-            tmp.push(a + (b - a) * (da / (da - db)));
-        }
-    }
-    std::mem::swap(poly, tmp);
+    clip_by(poly, |p| n.dot(p) - d, tmp);
 }
 
 /// Twice the signed area of a 2D polygon (positive: counter-clockwise).
