@@ -148,14 +148,20 @@ pub fn build_traced(scene: &Scene, octree: &Octree, params: PlieParams, progress
     let tols = Tolerances::new(tol, abs_scale);
     let propagate = params.propagation && params.regions;
     let order = propagation::task_order(scene, octree, propagate);
-    let mut states = FaceStates::new(scene, octree, tol);
+    let states = FaceStates::new(scene, octree, tol);
     let initial = states.clone();
     // Set at the commit that deletes a face: workers skip it (a face deleted later is computed anyway,
     // and its result discarded at its own commit).
     let deleted: Vec<AtomicBool> = (0..states.len()).map(|_| AtomicBool::new(false)).collect();
-    let mut propagator = Propagator::new(scene, octree, tols);
-    let mut tasks: Vec<TaskRecords> = (0..octree.leaf_count() * lights).map(|_| TaskRecords::default()).collect();
-    let (mut propagation_seconds, mut wasted) = (0.0, 0);
+    let mut commits = Commits {
+        states,
+        propagator: Propagator::new(scene, octree, tols),
+        tasks: (0..octree.leaf_count() * lights).map(|_| TaskRecords::default()).collect(),
+        lights,
+        propagate,
+        seconds: 0.0,
+        wasted: 0,
+    };
     let scratches: Vec<Mutex<GatherScratch>> = (0..rayon::current_num_threads().max(1))
         .map(|_| Mutex::new(GatherScratch::new(scene.triangles.len())))
         .collect();
@@ -177,39 +183,10 @@ pub fn build_traced(scene: &Scene, octree: &Octree, params: PlieParams, progress
             progress.advance(1);
             out
         },
-        // In task order: the faces' outcome, then propagation from the task's leaf (stage 6).
-        |k, out| {
-            let (leaf, light) = order[k];
-            let t = &mut tasks[leaf.idx() * lights + light.idx()];
-            for (face, fo) in Dir::ALL.into_iter().zip(out) {
-                match states.get(leaf, face, light) {
-                    FaceState::Pending => {}
-                    FaceState::Propagated { .. } => {
-                        wasted += fo.is_some() as usize;
-                        continue;
-                    }
-                    _ => continue,
-                }
-                let fo = fo.expect("a face pending at its task's commit was computed");
-                states.set(leaf, face, light, fo.state);
-                t.records[face.index()] = fo.record;
-                t.computed[face.index()] = Some(fo.state);
-                t.candidates += fo.candidates;
-                t.removed_umbra += matches!(fo.state, FaceState::Dark { .. }) as usize;
-                t.seconds += fo.seconds;
-            }
-            if propagate {
-                let t0 = Instant::now();
-                let before = propagator.log.len();
-                propagator.after_wave(&mut states, &[(leaf, light)]);
-                for d in &propagator.log[before..] {
-                    deleted[states.index(d.leaf, d.face, d.light)].store(true, Ordering::Release);
-                }
-                propagation_seconds += t0.elapsed().as_secs_f64();
-            }
-        },
+        |k, out| commits.commit(order[k], out, &deleted),
     );
     progress.finish();
+    let Commits { states, propagator, tasks, seconds: propagation_seconds, wasted, .. } = commits;
 
     let mut stats = BuildStats {
         leaves: octree.leaf_count(),
@@ -233,6 +210,54 @@ pub fn build_traced(scene: &Scene, octree: &Octree, params: PlieParams, progress
         stats.records_removed_propagation as f64 * stats.record_seconds_mean / threads - propagation_seconds;
     stats.blockers_seconds = t0.elapsed().as_secs_f64();
     Built { plie, stats, propagated }
+}
+
+/// What the commits own, in task order: the faces' states, the propagator and the results.
+struct Commits<'a> {
+    states: FaceStates,
+    propagator: Propagator<'a>,
+    tasks: Vec<TaskRecords>,
+    lights: usize,
+    propagate: bool,
+    /// Seconds spent propagating.
+    seconds: f64,
+    /// Faces computed, then found deleted at their commit.
+    wasted: usize,
+}
+
+impl Commits<'_> {
+    /// Commits one task: each face's outcome (computed, or deleted by an earlier commit), then
+    /// propagation from the task's leaf (stage 6); what it deletes is marked in `deleted` for the
+    /// workers.
+    fn commit(&mut self, (leaf, light): (LeafId, LightId), out: [Option<FaceOut>; 6], deleted: &[AtomicBool]) {
+        let t = &mut self.tasks[leaf.idx() * self.lights + light.idx()];
+        for (face, fo) in Dir::ALL.into_iter().zip(out) {
+            match self.states.get(leaf, face, light) {
+                FaceState::Pending => {}
+                FaceState::Propagated { .. } => {
+                    self.wasted += fo.is_some() as usize;
+                    continue;
+                }
+                _ => continue,
+            }
+            let fo = fo.expect("a face pending at its task's commit was computed");
+            self.states.set(leaf, face, light, fo.state);
+            t.records[face.index()] = fo.record;
+            t.computed[face.index()] = Some(fo.state);
+            t.candidates += fo.candidates;
+            t.removed_umbra += matches!(fo.state, FaceState::Dark { .. }) as usize;
+            t.seconds += fo.seconds;
+        }
+        if self.propagate {
+            let t0 = Instant::now();
+            let before = self.propagator.log.len();
+            self.propagator.after_commit(&mut self.states, &[(leaf, light)]);
+            for d in &self.propagator.log[before..] {
+                deleted[self.states.index(d.leaf, d.face, d.light)].store(true, Ordering::Release);
+            }
+            self.seconds += t0.elapsed().as_secs_f64();
+        }
+    }
 }
 
 /// The tasks' records flattened into the P-LIE (by leaf, face, light), with their statistics.

@@ -156,10 +156,10 @@ impl<'a> Propagator<'a> {
 
     /// After the commit of some (leaf, light) tasks: propagates from each that has a face known dark,
     /// light by light in task order.
-    pub fn after_wave(&mut self, states: &mut FaceStates, wave: &[(LeafId, LightId)]) {
+    pub fn after_commit(&mut self, states: &mut FaceStates, tasks: &[(LeafId, LightId)]) {
         for light in 0..self.scene.lights.len() as u32 {
             let light = LightId(light);
-            let sources: Vec<NodeId> = wave
+            let sources: Vec<NodeId> = tasks
                 .iter()
                 .filter(|&&(l, i)| i == light && Dir::ALL.iter().any(|&f| states.get(l, f, light).vouches().is_some()))
                 .map(|&(l, _)| self.octree.leaf_node(l))
