@@ -56,7 +56,7 @@ pub fn run(a: &Args) -> Result<()> {
             "records_removed": stats.records_removed_propagation,
             "tests": stats.propagation_tests,
             "by_rule": stats.propagation_by_rule,
-            "waves": stats.propagation_waves,
+            "wasted": stats.propagation_wasted,
             "seconds": stats.propagation_seconds,
             "record_seconds_mean": stats.record_seconds_mean,
             "seconds_saved_estimate": stats.propagation_seconds_saved_estimate,
@@ -143,11 +143,11 @@ pub fn run(a: &Args) -> Result<()> {
             println!("propagation     none (--no-propagation)");
         } else {
             println!(
-                "propagation     {} records removed without computing their blockers ({} of {} candidates proven; {} waves, {:.3} s propagating)",
+                "propagation     {} records removed without computing their blockers ({} of {} candidates proven; {} computed before being removed; {:.3} s propagating)",
                 stats.records_removed_propagation,
                 stats.records_removed_propagation,
                 stats.propagation_tests,
-                stats.propagation_waves,
+                stats.propagation_wasted,
                 stats.propagation_seconds
             );
             if stats.records_removed_propagation > 0 {

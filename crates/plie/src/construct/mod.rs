@@ -10,21 +10,23 @@
 //! 6. [`propagation`]: faces proven dark by a dark neighbour lose their record before stages 2-5 run
 //!    for them (§4.7).
 //!
-//! Refinement (§4.8) comes later. The (leaf, light) tasks run in waves ([`propagation::Waves`]), each
-//! wave in parallel with rayon, then propagation from it; the result does not depend on the thread
-//! count.
+//! Refinement (§4.8) comes later. The (leaf, light) tasks run in parallel in a fixed order and are
+//! committed in that order ([`schedule`]); propagation runs at each commit, so the result does not
+//! depend on the thread count.
 
 pub mod blockers;
 pub mod data_objects;
 pub mod grid;
 pub mod propagation;
 pub mod regions;
+pub mod schedule;
 pub mod shaft;
 
 use std::collections::BTreeMap;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Mutex;
 use std::time::Instant;
 
-use rayon::prelude::*;
 use serde::Serialize;
 
 use crate::lie::{FaceGrid, Plie, PlieParams, Record, RecordRegions, NO_RECORD, UMBRA_CELL};
@@ -72,9 +74,10 @@ pub struct BuildStats {
     pub propagation_by_rule: BTreeMap<&'static str, usize>,
     /// Principle tests run by propagation (pending candidates proposed by the rules).
     pub propagation_tests: usize,
-    /// Construction waves (1 without propagation).
-    pub propagation_waves: usize,
-    /// Seconds spent propagating (between waves, on one thread).
+    /// Records computed before an earlier task's commit deleted them, their result discarded (depends
+    /// on timing, unlike everything else here).
+    pub propagation_wasted: usize,
+    /// Seconds spent propagating (at the commits, one at a time).
     pub propagation_seconds: f64,
     /// Mean thread-seconds to compute one record (blockers, regions, grid), fully dark ones included.
     pub record_seconds_mean: f64,
@@ -152,63 +155,50 @@ pub fn build_traced(scene: &Scene, octree: &Octree, params: PlieParams, progress
     let tols = Tolerances::new(tol, abs_scale);
     let propagate = params.propagation && params.regions;
     let order = propagation::task_order(scene, octree, propagate);
-    let mut waves = propagation::Waves::new(order.len(), propagate);
-    let mut states = FaceStates::new(scene, octree, tol);
-    let mut propagator = Propagator::new(scene, octree, tols);
-    let mut tasks: Vec<TaskRecords> = (0..octree.leaf_count() * lights).map(|_| TaskRecords::default()).collect();
-    let (mut propagation_seconds, mut wave_count, mut found_dark) = (0.0, 0, false);
-    let scratches: Vec<std::sync::Mutex<GatherScratch>> = (0..rayon::current_num_threads().max(1))
-        .map(|_| std::sync::Mutex::new(GatherScratch::new(scene.triangles.len())))
+    let states = FaceStates::new(scene, octree, tol);
+    let initial = states.clone();
+    // Set at the commit that deletes a face: workers skip it (a face deleted later is computed anyway,
+    // and its result discarded at its own commit).
+    let deleted: Vec<AtomicBool> = (0..states.len()).map(|_| AtomicBool::new(false)).collect();
+    let mut commits = Commits {
+        states,
+        propagator: Propagator::new(scene, octree, tols),
+        tasks: (0..octree.leaf_count() * lights).map(|_| TaskRecords::default()).collect(),
+        lights,
+        propagate,
+        seconds: 0.0,
+        wasted: 0,
+    };
+    let scratches: Vec<Mutex<GatherScratch>> = (0..rayon::current_num_threads().max(1))
+        .map(|_| Mutex::new(GatherScratch::new(scene.triangles.len())))
         .collect();
     progress.start("blockers", order.len() as u64);
-    while let Some(range) = waves.next(found_dark) {
-        let wave = &order[range];
-        wave_count += 1;
-        // Every face still pending in the wave, one parallel item each (finer than a (leaf, light)
-        // task, so a wave's slowest item is short).
-        let frozen = &states;
-        let items: Vec<(usize, Dir)> = wave
-            .iter()
-            .enumerate()
-            .flat_map(|(i, &(leaf, light))| {
-                let pending = Dir::ALL.into_iter().filter(move |&f| frozen.get(leaf, f, light) == FaceState::Pending);
-                pending.map(move |f| (i, f))
-            })
-            .collect();
-        let done: Vec<FaceOut> = items
-            .par_iter()
-            .map(|&(i, face)| {
-                // One scratch per worker thread, kept across waves (an item never waits for another).
-                let slot = &scratches[rayon::current_thread_index().unwrap_or(0) % scratches.len()];
-                let mut scratch = slot.lock().unwrap_or_else(|e| e.into_inner());
-                face_record(scene, octree, wave[i], face, &tols, abs_scale, params, &mut scratch)
-            })
-            .collect();
-        found_dark = false;
-        for (&(i, face), out) in items.iter().zip(done) {
-            let (leaf, light) = wave[i];
-            found_dark |= out.state.vouches().is_some();
-            states.set(leaf, face, light, out.state);
-            let t = &mut tasks[leaf.idx() * lights + light.idx()];
-            t.records[face.index()] = out.record;
-            t.computed[face.index()] = Some(out.state);
-            t.candidates += out.candidates;
-            t.removed_umbra += matches!(out.state, FaceState::Dark { .. }) as usize;
-            t.seconds += out.seconds;
-        }
-        progress.advance(wave.len() as u64);
-        if propagate {
-            let t = Instant::now();
-            propagator.after_wave(&mut states, wave);
-            propagation_seconds += t.elapsed().as_secs_f64();
-        }
-    }
+    schedule::run_ordered(
+        order.len(),
+        // Stages 2-5 for the task's faces that are pending and not deleted yet.
+        |k| {
+            let (leaf, light) = order[k];
+            // One scratch per worker thread (a task never waits for another).
+            let slot = &scratches[rayon::current_thread_index().unwrap_or(0) % scratches.len()];
+            let mut scratch = slot.lock().unwrap_or_else(|e| e.into_inner());
+            let out: [Option<FaceOut>; 6] = std::array::from_fn(|f| {
+                let face = Dir::from_index(f);
+                let pending = initial.get(leaf, face, light) == FaceState::Pending;
+                let todo = pending && !deleted[initial.index(leaf, face, light)].load(Ordering::Acquire);
+                todo.then(|| face_record(scene, octree, (leaf, light), face, &tols, abs_scale, params, &mut scratch))
+            });
+            progress.advance(1);
+            out
+        },
+        |k, out| commits.commit(order[k], out, &deleted),
+    );
     progress.finish();
+    let Commits { states, propagator, tasks, seconds: propagation_seconds, wasted, .. } = commits;
 
     let mut stats = BuildStats {
         leaves: octree.leaf_count(),
         faces_considered: octree.leaf_count() * 6 * lights,
-        propagation_waves: wave_count,
+        propagation_wasted: wasted,
         propagation_seconds,
         ..Default::default()
     };
@@ -227,6 +217,54 @@ pub fn build_traced(scene: &Scene, octree: &Octree, params: PlieParams, progress
         stats.records_removed_propagation as f64 * stats.record_seconds_mean / threads - propagation_seconds;
     stats.blockers_seconds = t0.elapsed().as_secs_f64();
     Built { plie, stats, propagated }
+}
+
+/// What the commits own, in task order: the faces' states, the propagator and the results.
+struct Commits<'a> {
+    states: FaceStates,
+    propagator: Propagator<'a>,
+    tasks: Vec<TaskRecords>,
+    lights: usize,
+    propagate: bool,
+    /// Seconds spent propagating.
+    seconds: f64,
+    /// Faces computed, then found deleted at their commit.
+    wasted: usize,
+}
+
+impl Commits<'_> {
+    /// Commits one task: each face's outcome (computed, or deleted by an earlier commit), then
+    /// propagation from the task's leaf (stage 6); what it deletes is marked in `deleted` for the
+    /// workers.
+    fn commit(&mut self, (leaf, light): (LeafId, LightId), out: [Option<FaceOut>; 6], deleted: &[AtomicBool]) {
+        let t = &mut self.tasks[leaf.idx() * self.lights + light.idx()];
+        for (face, fo) in Dir::ALL.into_iter().zip(out) {
+            match self.states.get(leaf, face, light) {
+                FaceState::Pending => {}
+                FaceState::Propagated { .. } => {
+                    self.wasted += fo.is_some() as usize;
+                    continue;
+                }
+                _ => continue,
+            }
+            let fo = fo.expect("a face pending at its task's commit was computed");
+            self.states.set(leaf, face, light, fo.state);
+            t.records[face.index()] = fo.record;
+            t.computed[face.index()] = Some(fo.state);
+            t.candidates += fo.candidates;
+            t.removed_umbra += matches!(fo.state, FaceState::Dark { .. }) as usize;
+            t.seconds += fo.seconds;
+        }
+        if self.propagate {
+            let t0 = Instant::now();
+            let before = self.propagator.log.len();
+            self.propagator.after_commit(&mut self.states, &[(leaf, light)]);
+            for d in &self.propagator.log[before..] {
+                deleted[self.states.index(d.leaf, d.face, d.light)].store(true, Ordering::Release);
+            }
+            self.seconds += t0.elapsed().as_secs_f64();
+        }
+    }
 }
 
 /// The tasks' records flattened into the P-LIE (by leaf, face, light), with their statistics.

@@ -50,19 +50,17 @@
 //!
 //! # Order and determinism
 //!
-//! Construction runs in *waves* ([`Waves`]): the (leaf, light) tasks sorted by the distance from the
-//! leaf's centre to the light's centre (ties by leaf, then light, [`task_order`]), cut into waves of
-//! [`WAVE_MIN`] tasks after a wave that found a face dark, and of twice the previous size (up to
-//! [`WAVE_MAX`]) after one that found none: such a wave gives propagation nothing to start from, so
-//! the next barrier would only cost time (a wave waits for its slowest item). The pending faces of a
-//! wave's tasks run in parallel, one item each (faces deleted by earlier waves are skipped), against a
-//! frozen [`FaceStates`]; then, sequentially and in task order, the wave's leaves propagate
-//! ([`Propagator`]), which only turns `Pending` faces (of later waves) into `Propagated`. Waves and
-//! propagation depend on the scene alone (wave sizes on computed results, which do too), so the P-LIE
-//! does not depend on the thread count. Dark faces lie behind blockers
-//! as seen from the light and the faces they prove lie farther on, so most are still pending when
-//! their source's wave ends; two adjacent cells in one wave cannot help each other, which is the
-//! price of running a wave in parallel (see docs/results.md). Without propagation there is one wave.
+//! Propagation needs an order: a face can only be deleted before it is computed. The (leaf, light)
+//! tasks are sorted by the distance from the leaf's centre to the light's centre (ties by leaf, then
+//! light: [`task_order`]) and run by [`crate::construct::schedule::run_ordered`]: in parallel, but
+//! *committed* strictly in that order. At its commit a task's faces get their outcome (computed, or
+//! deleted by an earlier commit) and its leaf propagates ([`Propagator`]), which only turns faces of
+//! tasks not yet committed (`Pending`) into `Propagated`. So the P-LIE is the one a single thread would
+//! build in that order, whatever the thread count. Workers skip faces already deleted when they reach
+//! them; a face deleted by a commit that comes after its worker started is computed for nothing (the
+//! timing-dependent `propagation_wasted` of [`crate::construct::BuildStats`]). Dark faces lie behind
+//! blockers as seen from the light and the faces they prove lie farther on, so they are usually still
+//! ahead of the workers. There is no barrier: a slow task delays commits, never the other workers.
 
 pub mod principle;
 pub mod rules;
@@ -76,13 +74,6 @@ pub use state::{dark_budget, FaceState, FaceStates};
 
 use crate::octree::{Dir, LeafId, Neighbour, NodeId, Octree};
 use crate::scene::{LightId, Scene};
-
-/// Tasks in a wave after a wave that found a face dark (see the module doc).
-pub const WAVE_MIN: usize = 16;
-
-/// Most tasks in a wave: after a wave that found no face dark (no new source), the next wave is twice
-/// as large, up to this.
-pub const WAVE_MAX: usize = 512;
 
 /// The tolerances of propagation: the construction tolerance `tol` and the distance `delta` within
 /// which a shadow ray's exit face is decided.
@@ -117,9 +108,9 @@ pub struct Propagated {
     pub source: NodeId,
 }
 
-/// The (leaf, light) construction tasks in the order they run: with `propagate` false in (leaf, light)
-/// order (one wave, see [`Waves`]); else sorted by the distance from the leaf's centre to the light's
-/// centre, ties by leaf then light.
+/// The (leaf, light) construction tasks in the order they are committed: with `propagate` false in
+/// (leaf, light) order; else sorted by the distance from the leaf's centre to the light's centre, ties
+/// by leaf then light.
 pub fn task_order(scene: &Scene, octree: &Octree, propagate: bool) -> Vec<(LeafId, LightId)> {
     let lights = scene.lights.len() as u32;
     let mut tasks: Vec<(LeafId, LightId)> =
@@ -130,38 +121,6 @@ pub fn task_order(scene: &Scene, octree: &Octree, propagate: bool) -> Vec<(LeafI
         tasks.sort_by(|a, b| dist(a).total_cmp(&dist(b)).then(a.cmp(b)));
     }
     tasks
-}
-
-/// Cuts the task order into waves: one wave without propagation; else [`WAVE_MIN`] tasks after a
-/// wave that found a face dark, twice the last size (up to [`WAVE_MAX`]) after one that found none.
-/// The sizes depend only on computed results, never on the thread count.
-#[derive(Clone, Debug)]
-pub struct Waves {
-    next: usize,
-    len: usize,
-    size: usize,
-    propagate: bool,
-}
-
-impl Waves {
-    /// Waves over `len` tasks.
-    pub fn new(len: usize, propagate: bool) -> Waves {
-        Waves { next: 0, len, size: if propagate { WAVE_MIN } else { len }, propagate }
-    }
-
-    /// The task range of the next wave, given whether the previous one found a face dark that can
-    /// vouch for propagation; `None` when every task ran.
-    pub fn next(&mut self, found_dark: bool) -> Option<std::ops::Range<usize>> {
-        if self.next >= self.len {
-            return None;
-        }
-        if self.propagate && self.next > 0 {
-            self.size = if found_dark { WAVE_MIN } else { (2 * self.size).min(WAVE_MAX) };
-        }
-        let r = self.next..(self.next + self.size).min(self.len);
-        self.next = r.end;
-        Some(r)
-    }
 }
 
 /// Runs the rules from source cells until nothing changes, recording what it deletes.
@@ -195,12 +154,12 @@ impl<'a> Propagator<'a> {
         }
     }
 
-    /// After a wave: propagates from each of its (leaf, light) tasks that has a dark face, light by
-    /// light in task order.
-    pub fn after_wave(&mut self, states: &mut FaceStates, wave: &[(LeafId, LightId)]) {
+    /// After the commit of some (leaf, light) tasks: propagates from each that has a face known dark,
+    /// light by light in task order.
+    pub fn after_commit(&mut self, states: &mut FaceStates, tasks: &[(LeafId, LightId)]) {
         for light in 0..self.scene.lights.len() as u32 {
             let light = LightId(light);
-            let sources: Vec<NodeId> = wave
+            let sources: Vec<NodeId> = tasks
                 .iter()
                 .filter(|&&(l, i)| i == light && Dir::ALL.iter().any(|&f| states.get(l, f, light).vouches().is_some()))
                 .map(|&(l, _)| self.octree.leaf_node(l))

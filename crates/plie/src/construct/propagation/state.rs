@@ -72,21 +72,32 @@ impl FaceStates {
         FaceStates { lights, states }
     }
 
+    /// The index of (leaf, face, light), `0..len()`.
     #[inline]
-    fn slot(&self, leaf: LeafId, face: Dir, light: LightId) -> usize {
+    pub fn index(&self, leaf: LeafId, face: Dir, light: LightId) -> usize {
         (leaf.idx() * 6 + face.index()) * self.lights + light.idx()
+    }
+
+    /// Number of (leaf, face, light).
+    pub fn len(&self) -> usize {
+        self.states.len()
+    }
+
+    /// True if there is no leaf or no light.
+    pub fn is_empty(&self) -> bool {
+        self.states.is_empty()
     }
 
     /// The state of (leaf, face, light).
     #[inline]
     pub fn get(&self, leaf: LeafId, face: Dir, light: LightId) -> FaceState {
-        self.states[self.slot(leaf, face, light)]
+        self.states[self.index(leaf, face, light)]
     }
 
     /// Sets the state of (leaf, face, light).
     #[inline]
     pub fn set(&mut self, leaf: LeafId, face: Dir, light: LightId, s: FaceState) {
-        let i = self.slot(leaf, face, light);
+        let i = self.index(leaf, face, light);
         self.states[i] = s;
     }
 
