@@ -42,7 +42,8 @@ pub fn run(a: &Args) -> Result<()> {
     let t = Instant::now();
     let octree = Octree::build(&scene, params.octree());
     let octree_seconds = t.elapsed().as_secs_f64();
-    let (plie, mut stats) = plie::construct::build(&scene, &octree, params, &bar);
+    let built = plie::construct::build_refined(&scene, octree, params, &bar);
+    let (octree, plie, mut stats) = (built.octree, built.plie, built.stats);
     stats.octree_seconds = octree_seconds;
     let build_seconds = t_all.elapsed().as_secs_f64();
     let t = Instant::now();
@@ -60,6 +61,15 @@ pub fn run(a: &Args) -> Result<()> {
             "seconds": stats.propagation_seconds,
             "record_seconds_mean": stats.record_seconds_mean,
             "seconds_saved_estimate": stats.propagation_seconds_saved_estimate,
+        });
+        let refinement = json!({
+            "criteria": params.refine.chain().iter().map(|c| c.name()).collect::<Vec<_>>(),
+            "max_split_depth": params.refine.max_split_depth,
+            "max_blockers": params.refine.blockers.map(|m| format!("{m:?}")),
+            "rounds": stats.refine_rounds,
+            "splits_by_criterion": stats.refine_splits,
+            "leaves_added": 7 * stats.refine_splits.values().sum::<usize>(),
+            "unrefined": stats.unrefined,
         });
         let v = json!({
             "scene": scene.name,
@@ -85,6 +95,7 @@ pub fn run(a: &Args) -> Result<()> {
             "records_removed_umbra": stats.records_removed_umbra,
             "records_removed_propagation": stats.records_removed_propagation,
             "propagation": propagation,
+            "refinement": refinement,
             "records_with_umbra": stats.records_with_umbra,
             "records_with_penumbra": stats.records_with_penumbra,
             "region_polygon_vertices": stats.region_polygon_vertices,
@@ -160,6 +171,7 @@ pub fn run(a: &Args) -> Result<()> {
                 1e3 * stats.record_seconds_mean
             );
         }
+        print_refinement(&params, &stats);
         if !params.grids {
             println!("face grids      none (--no-grids)");
         } else {
@@ -177,4 +189,33 @@ pub fn run(a: &Args) -> Result<()> {
         println!("file            {} ({file_bytes} bytes, written in {write_seconds:.3} s)", a.output.display());
     }
     Ok(())
+}
+
+/// The summary lines of refinement (SPEC §4.8): leaves added per criterion, and what it changed.
+fn print_refinement(params: &plie::lie::PlieParams, stats: &plie::construct::BuildStats) {
+    let (Some(u), true) = (stats.unrefined, params.refine.enabled()) else {
+        println!("refinement      none (--refine to enable)");
+        return;
+    };
+    let added: usize = 7 * stats.refine_splits.values().sum::<usize>();
+    let by: Vec<String> =
+        stats.refine_splits.iter().map(|(c, n)| format!("{c} {n} splits (+{} leaves)", 7 * n)).collect();
+    println!(
+        "refinement      +{added} leaves in {} rounds (max split depth {}){}{}",
+        stats.refine_rounds,
+        params.refine.max_split_depth,
+        if by.is_empty() { "" } else { ": " },
+        by.join(", ")
+    );
+    println!(
+        "                leaves {} -> {}, records {} -> {}, blockers {} -> {}, construction {:.3} s -> {:.3} s",
+        u.leaves,
+        stats.leaves,
+        u.records,
+        stats.records,
+        u.blockers_total,
+        stats.blockers_total,
+        u.seconds,
+        stats.blockers_seconds
+    );
 }

@@ -142,9 +142,8 @@ pub fn run(a: &Args) -> Result<()> {
         Some(path) => plie::io::plie_file::load_plie(path, &scene, Some(params))
             .with_context(|| format!("cannot use P-LIE file {}", path.display()))?,
         None => {
-            let octree = Octree::build(&scene, params.octree());
-            let plie = plie::construct::build(&scene, &octree, params, &bar).0;
-            (octree, plie)
+            let built = plie::construct::build_refined(&scene, Octree::build(&scene, params.octree()), params, &bar);
+            (built.octree, built.plie)
         }
     };
     let inspector = Inspector::new(&scene, &octree, &plie)?;

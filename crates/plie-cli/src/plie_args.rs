@@ -1,7 +1,9 @@
-//! `--max-triangles`, `--max-depth`, `--no-grids`, `--no-regions` and `--no-propagation`: the P-LIE build parameters
-//! (SPEC §4.9) shared by `plie build` and `plie render`.
+//! `--max-triangles`, `--max-depth`, `--no-grids`, `--no-regions`, `--no-propagation`, `--refine`,
+//! `--max-split-depth` and `--max-blockers`: the P-LIE build parameters (SPEC §4.9) shared by
+//! `plie build`, `plie render` and `plie inspect`.
 
-use anyhow::Result;
+use anyhow::{bail, Result};
+use plie::construct::refine::{MaxBlockers, RefineParams};
 use plie::lie::PlieParams;
 use plie::octree::OctreeParams;
 
@@ -25,6 +27,41 @@ pub struct PlieArgs {
     /// computed. Same records except fully dark ones; only construction time changes.
     #[arg(long)]
     pub no_propagation: bool,
+    /// P-LIE: refine the octree after the records are known (SPEC §4.8), by a comma-separated chain
+    /// of criteria: `umbra` (rules 1 and 2), `umbra-full` (rule 1: a child face would be fully in
+    /// umbra), `umbra-free` (rule 2: a child face would have no blockers), `blockers` (more than
+    /// `--max-blockers` on one face and light). The thesis' test 2 is `--refine umbra`.
+    #[arg(long, value_name = "CRITERIA", value_delimiter = ',')]
+    pub refine: Vec<RefineCriterion>,
+    /// Refinement: how many times a leaf may be split (thesis: 2).
+    #[arg(long, default_value_t = 2, value_name = "K")]
+    pub max_split_depth: u32,
+    /// Refinement by `blockers`: split when one face and light has more blockers than N, or
+    /// `adaptive` (the scene's triangle count over twice the leaf's depth, thesis §8.3.3).
+    #[arg(long, value_name = "N|adaptive", value_parser = parse_max_blockers)]
+    pub max_blockers: Option<MaxBlockers>,
+}
+
+/// A value of `--refine`.
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum RefineCriterion {
+    /// Umbra rules 1 and 2.
+    Umbra,
+    /// Umbra rule 1.
+    UmbraFull,
+    /// Umbra rule 2.
+    UmbraFree,
+    /// Blockers per face and light.
+    Blockers,
+}
+
+fn parse_max_blockers(s: &str) -> std::result::Result<MaxBlockers, String> {
+    if s == "adaptive" {
+        return Ok(MaxBlockers::Adaptive);
+    }
+    s.parse::<u32>()
+        .map(MaxBlockers::Fixed)
+        .map_err(|_| format!("expected a number of blockers or `adaptive`, not `{s}`"))
 }
 
 impl PlieArgs {
@@ -36,8 +73,29 @@ impl PlieArgs {
             grids: want_grids && !self.no_grids,
             regions: !self.no_regions,
             propagation: !self.no_propagation,
+            refine: self.refine_params()?,
         };
         p.octree().validate()?;
+        p.refine.validate(p.regions)?;
         Ok(p)
+    }
+
+    /// The refinement asked for.
+    fn refine_params(&self) -> Result<RefineParams> {
+        let has = |c| self.refine.contains(&c);
+        let umbra = has(RefineCriterion::Umbra);
+        let blockers = has(RefineCriterion::Blockers);
+        if blockers && self.max_blockers.is_none() {
+            bail!("--refine blockers needs --max-blockers N or --max-blockers adaptive");
+        }
+        if !blockers && self.max_blockers.is_some() {
+            bail!("--max-blockers only applies to --refine blockers");
+        }
+        Ok(RefineParams {
+            umbra_full: umbra || has(RefineCriterion::UmbraFull),
+            umbra_free: umbra || has(RefineCriterion::UmbraFree),
+            blockers: self.max_blockers.filter(|_| blockers),
+            max_split_depth: self.max_split_depth,
+        })
     }
 }

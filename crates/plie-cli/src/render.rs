@@ -104,7 +104,12 @@ pub fn run(a: &Args) -> Result<()> {
         (_, needs) => {
             let octree = Octree::build(&scene, params.octree());
             let t = Instant::now();
-            let plie = needs.then(|| plie::construct::build(&scene, &octree, params, &bar).0);
+            let (octree, plie) = if needs {
+                let built = plie::construct::build_refined(&scene, octree, params, &bar);
+                (built.octree, Some(built.plie))
+            } else {
+                (octree, None)
+            };
             (octree, plie, needs.then(|| t.elapsed().as_secs_f64()), None)
         }
     };

@@ -419,3 +419,67 @@ fn bench_quick_writes_report_csv_json_and_chart() {
     assert!(svg.trim_start().starts_with("<svg") && svg.trim_end().ends_with("</svg>"), "not an SVG");
     assert!(scenes.iter().all(|s| svg.contains(s)), "chart lacks the scene names");
 }
+
+#[test]
+fn build_refines_by_umbra_and_render_uses_the_refined_p_lie() {
+    let dir = tempfile::tempdir().unwrap();
+    let f = dir.path().join("c5.plie");
+    let fs = f.to_str().unwrap();
+    let o = plie(&["build", "--scene", "cornell-cube-5", "--refine", "umbra", "-o", fs, "--json"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).expect("one JSON object");
+    let r = &v["refinement"];
+    assert_eq!(r["criteria"], serde_json::json!(["umbra_full", "umbra_free"]));
+    assert_eq!(r["max_split_depth"], 2);
+    let added = r["leaves_added"].as_u64().unwrap();
+    assert!(added > 0 && r["rounds"].as_u64().unwrap() >= 1, "{v}");
+    let unrefined = r["unrefined"]["leaves"].as_u64().unwrap();
+    assert_eq!(v["leaves"].as_u64().unwrap(), unrefined + added);
+    // The text summary names the criteria and the before/after figures.
+    let o = plie(&["build", "--scene", "cornell-cube-5", "--refine", "umbra", "-o", fs]);
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert!(text.contains(&format!("refinement      +{added} leaves")) && text.contains("records"), "{text}");
+    // Rendering with the saved, refined P-LIE gives the brute-force image.
+    let img = |name: &str, extra: &[&str]| {
+        let out = dir.path().join(name);
+        let base = ["render", "--scene", "cornell-cube-5", "--width", "24", "--height", "24", "--quiet", "-o"];
+        let o = plie(&[&base[..], &[out.to_str().unwrap()], extra].concat());
+        assert!(o.status.success(), "{}", stderr(&o));
+        std::fs::read(out).unwrap()
+    };
+    let brute = img("brute.pfm", &["--visibility", "brute"]);
+    assert_eq!(img("loaded.pfm", &["--visibility", "umbra", "--plie", fs, "--refine", "umbra"]), brute);
+    assert_eq!(
+        img("built.pfm", &["--visibility", "grid", "--refine", "umbra,blockers", "--max-blockers", "adaptive"]),
+        brute
+    );
+    // Loading asks for the refinement the file was built with.
+    let x = dir.path().join("x.png");
+    fails_with(
+        &["render", "--scene", "cornell-cube-5", "--visibility", "lie", "--plie", fs, "-o", x.to_str().unwrap()],
+        "other parameters",
+    );
+    assert!(!x.exists());
+}
+
+#[test]
+fn bad_refinement_options_give_one_line_errors() {
+    let base = ["build", "--scene", "cornell-cube-1", "-o", "never.plie"];
+    fn with<'a>(base: &[&'a str], extra: &[&'a str]) -> Vec<&'a str> {
+        [base, extra].concat()
+    }
+    fails_with(&with(&base, &["--refine", "blockers"]), "--max-blockers");
+    fails_with(&with(&base, &["--max-blockers", "10"]), "--refine blockers");
+    // Values clap refuses: its error and usage hint, no panic.
+    for (args, needle) in [(&["--max-blockers", "many"][..], "adaptive"), (&["--refine", "shadows"][..], "shadows")] {
+        let o = plie(&with(&base, args));
+        assert!(
+            !o.status.success() && !stderr(&o).contains("panicked") && stderr(&o).contains(needle),
+            "{}",
+            stderr(&o)
+        );
+    }
+    fails_with(&with(&base, &["--refine", "umbra", "--no-regions"]), "regions");
+    fails_with(&with(&base, &["--refine", "umbra", "--max-split-depth", "40"]), "depth");
+    assert!(!Path::new("never.plie").exists());
+}

@@ -112,3 +112,31 @@ fn saving_is_atomic_and_keeps_existing_files_on_error() {
     let leftovers: Vec<_> = std::fs::read_dir(dir.path()).unwrap().map(|e| e.unwrap().file_name()).collect();
     assert_eq!(leftovers.len(), 1, "no temporary files left: {leftovers:?}");
 }
+
+/// A refined P-LIE (SPEC §4.8) saves its split nodes: loading replays them and gives the same octree,
+/// P-LIE and image; asking for another refinement, or a file whose split list was tampered with (and
+/// re-checksummed), is an error.
+#[test]
+fn refined_round_trip_and_refinement_mismatch() {
+    use plie::construct::refine::RefineParams;
+    let dir = tempfile::tempdir().unwrap();
+    let scene = plie::scene::builtin::load("cornell-cube-5").unwrap();
+    let params = PlieParams { refine: RefineParams::thesis_umbra(), ..PlieParams::thesis() };
+    let b = plie::construct::build_refined(&scene, Octree::build(&scene, params.octree()), params, &NoProgress);
+    assert!(!b.plie.splits.is_empty());
+    let path = dir.path().join("refined.plie");
+    save_plie(&path, &scene, &b.octree, &b.plie).unwrap();
+    let (octree2, p2) = load_plie(&path, &scene, Some(params)).unwrap();
+    assert!(octree2 == b.octree && p2 == b.plie);
+    assert_eq!(image(&scene, &b.octree, &b.plie), image(&scene, &octree2, &p2));
+    assert!(load_plie(&path, &scene, None).is_ok());
+    let e = err_of(load_plie(&path, &scene, Some(PlieParams::thesis())));
+    assert!(e.contains("other parameters"), "{e}");
+    // A split list naming a node that is no leaf: the file is refused.
+    let mut bad = b.plie.clone();
+    bad.splits[0][0] = 0;
+    let q = dir.path().join("bad-splits.plie");
+    save_plie(&q, &scene, &b.octree, &bad).unwrap();
+    let e = err_of(load_plie(&q, &scene, None));
+    assert!(e.contains("inconsistent") && e.contains("node 0"), "{e}");
+}

@@ -10,14 +10,19 @@
 //! 6. [`propagation`]: faces proven dark by a dark neighbour lose their record before stages 2-5 run
 //!    for them (§4.7).
 //!
-//! Refinement (§4.8) comes later. The (leaf, light) tasks run in parallel in a fixed order and are
-//! committed in that order ([`schedule`]); propagation runs at each commit, so the result does not
-//! depend on the thread count.
+//! 7. [`refine`]: a chain of criteria picks leaves to split (§4.8); the next round computes the new
+//!    leaves' records with stages 1-6 and reuses every other record (they do not depend on how other
+//!    leaves are split), until no leaf asks or the maximum split depth is reached.
+//!
+//! The (leaf, light) tasks of a round run in parallel in a fixed order and are committed in that
+//! order ([`schedule`]); propagation runs at each commit, so the result does not depend on the thread
+//! count.
 
 pub mod blockers;
 pub mod data_objects;
 pub mod grid;
 pub mod propagation;
+pub mod refine;
 pub mod regions;
 pub mod schedule;
 pub mod shaft;
@@ -26,6 +31,8 @@ use std::collections::BTreeMap;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Mutex;
 use std::time::Instant;
+
+use rayon::prelude::*;
 
 use serde::Serialize;
 
@@ -107,10 +114,30 @@ pub struct BuildStats {
     pub grid_cells_umbra: usize,
     /// Grid cells in all.
     pub grid_cells: usize,
+    /// Refinement rounds that split some leaf (§4.8).
+    pub refine_rounds: usize,
+    /// Leaves split by refinement, by the criterion that asked ([`refine::Criterion::name`]); each
+    /// split adds 7 leaves.
+    pub refine_splits: BTreeMap<&'static str, usize>,
+    /// With refinement: the first round's figures, i.e. the P-LIE without refinement.
+    pub unrefined: Option<RoundStats>,
     /// Seconds building the octree.
     pub octree_seconds: f64,
     /// Seconds computing data objects, shafts, blockers, regions and grids, propagation included.
     pub blockers_seconds: f64,
+}
+
+/// The figures of one construction round (see [`BuildStats::unrefined`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+pub struct RoundStats {
+    /// Leaves of the octree.
+    pub leaves: usize,
+    /// Records kept.
+    pub records: usize,
+    /// Blocker references of the kept records.
+    pub blockers_total: usize,
+    /// Seconds from the start of the construction to the end of the round.
+    pub seconds: f64,
 }
 
 /// One record before flattening.
@@ -130,40 +157,213 @@ struct TaskRecords {
     seconds: f64,
 }
 
-/// The P-LIE, its statistics, and the records propagation deleted.
+/// The P-LIE, the octree it belongs to, its statistics, and the records propagation deleted.
 pub struct Built {
+    /// The octree (refined if refinement split any leaf).
+    pub octree: Octree,
     /// The P-LIE.
     pub plie: Plie,
     /// Its statistics.
     pub stats: BuildStats,
-    /// The records deleted by propagation, in the order they were.
+    /// The records deleted by propagation (leaves of [`Built::octree`]), in the order they were.
     pub propagated: Vec<Propagated>,
 }
 
-/// Builds the P-LIE of `scene` over `octree` (stages 1-6).
+/// Builds the P-LIE of `scene` over `octree` (stages 1-6), without refinement.
+///
+/// # Panics
+/// If `params.refine` asks for refinement, which changes the octree: use [`build_refined`].
 pub fn build(scene: &Scene, octree: &Octree, params: PlieParams, progress: &dyn Progress) -> (Plie, BuildStats) {
     let b = build_traced(scene, octree, params, progress);
     (b.plie, b.stats)
 }
 
 /// [`build`], also returning which records propagation deleted (for tests and reports).
+///
+/// # Panics
+/// If `params.refine` asks for refinement: use [`build_refined`].
 pub fn build_traced(scene: &Scene, octree: &Octree, params: PlieParams, progress: &dyn Progress) -> Built {
+    assert!(!params.refine.enabled(), "construct::build does not refine the octree: use construct::build_refined");
+    build_refined(scene, octree.clone(), params, progress)
+}
+
+/// Builds the P-LIE of `scene` over `octree` (stages 1-6) and refines the octree as `params.refine`
+/// asks (stage 7), returning the refined octree with it.
+pub fn build_refined(scene: &Scene, octree: Octree, params: PlieParams, progress: &dyn Progress) -> Built {
     let t0 = Instant::now();
+    let triangles = scene.triangles.len();
+    let max_split = params.refine.max_split_depth;
+    let mut octree = octree;
+    // Times each leaf's region of the original octree has been split.
+    let mut level = vec![0u32; octree.leaf_count()];
+    let mut splits: Vec<Vec<u32>> = Vec::new();
+    let mut by_criterion: BTreeMap<&'static str, usize> = BTreeMap::new();
+    let mut prior = None;
+    let mut unrefined = None;
+    // Propagation figures summed over the rounds.
+    let (mut tests, mut wasted, mut propagation_seconds) = (0, 0, 0.0);
+    let round = loop {
+        let stage = if splits.is_empty() { "blockers".to_string() } else { format!("refine {}", splits.len()) };
+        let round = run_round(scene, &octree, params, progress, &stage, prior.take());
+        tests += round.tests;
+        wasted += round.wasted;
+        propagation_seconds += round.seconds;
+        if unrefined.is_none() && params.refine.enabled() {
+            unrefined = Some(round.summary(&octree, t0));
+        }
+        if !params.refine.enabled() {
+            break round;
+        }
+        let lights = scene.lights.len();
+        let candidates: Vec<LeafId> =
+            octree.leaves().filter(|&l| level[l.idx()] < max_split && octree.can_split(l)).collect();
+        let decisions: Vec<Option<refine::Criterion>> = candidates
+            .par_iter()
+            .map(|&l| {
+                let faces: Vec<refine::FaceView> = (0..lights)
+                    .flat_map(|i| round.tasks[l.idx() * lights + i].records.iter().flatten())
+                    .map(|r| refine::FaceView { blockers: r.blockers.len(), regions: r.regions.as_ref() })
+                    .collect();
+                refine::decide(&faces, &params.refine, triangles, octree.leaf_depth(l))
+            })
+            .collect();
+        let split: Vec<LeafId> =
+            candidates.iter().zip(&decisions).filter(|(_, d)| d.is_some()).map(|(&l, _)| l).collect();
+        if split.is_empty() {
+            break round;
+        }
+        for d in decisions.iter().flatten() {
+            *by_criterion.entry(d.name()).or_default() += 1;
+        }
+        splits.push(split.iter().map(|&l| octree.leaf_node(l).0).collect());
+        let (refined, origin) = octree.split_leaves(scene, &split);
+        let kept = origin.iter().filter(|o| o.is_some()).count();
+        level = origin
+            .iter()
+            .enumerate()
+            .map(|(i, o)| match o {
+                Some(old) => level[old.idx()],
+                None => level[split[(i - kept) / 8].idx()] + 1,
+            })
+            .collect();
+        prior = Some(Prior { round, origin });
+        octree = refined;
+    };
+    let Round { tasks, propagator_log: propagated, states, .. } = round;
+    let lights = scene.lights.len();
+    let mut stats = BuildStats {
+        leaves: octree.leaf_count(),
+        faces_considered: octree.leaf_count() * 6 * lights,
+        propagation_wasted: wasted,
+        propagation_seconds,
+        refine_rounds: splits.len(),
+        refine_splits: by_criterion,
+        unrefined,
+        ..Default::default()
+    };
+    let mut plie = flatten(&octree, params, lights, tasks, &mut stats);
+    plie.splits = splits;
+    stats.propagation_tests = tests;
+    stats.records_removed_propagation = propagated.len();
+    debug_assert_eq!(propagated.len(), states.propagated());
+    for p in &propagated {
+        *stats.propagation_by_rule.entry(p.rule.name()).or_default() += 1;
+    }
+    stats.no_record_face_cannot_see_light =
+        stats.faces_considered - stats.records - stats.records_removed_umbra - stats.records_removed_propagation;
+    let threads = rayon::current_num_threads().max(1) as f64;
+    stats.propagation_seconds_saved_estimate =
+        stats.records_removed_propagation as f64 * stats.record_seconds_mean / threads - propagation_seconds;
+    stats.blockers_seconds = t0.elapsed().as_secs_f64();
+    Built { octree, plie, stats, propagated }
+}
+
+/// What one round computed: every (leaf, light) task's records, every face's state, and what
+/// propagation did.
+struct Round {
+    tasks: Vec<TaskRecords>,
+    states: FaceStates,
+    propagator_log: Vec<Propagated>,
+    tests: usize,
+    wasted: usize,
+    seconds: f64,
+}
+
+impl Round {
+    /// The round's figures, `t0` being the start of the construction.
+    fn summary(&self, octree: &Octree, t0: Instant) -> RoundStats {
+        let records = self.tasks.iter().flat_map(|t| t.records.iter().flatten());
+        RoundStats {
+            leaves: octree.leaf_count(),
+            records: records.clone().count(),
+            blockers_total: records.map(|r| r.blockers.len()).sum(),
+            seconds: t0.elapsed().as_secs_f64(),
+        }
+    }
+}
+
+/// The previous round and, for each leaf of the refined octree, the leaf of the previous one it is
+/// (`None` for a new child).
+struct Prior {
+    round: Round,
+    origin: Vec<Option<LeafId>>,
+}
+
+/// Stages 1-6 for every (leaf, light) of `octree`; with `prior`, the tasks of leaves that were not
+/// split are taken from it instead of computed again (their records do not depend on other leaves).
+fn run_round(
+    scene: &Scene,
+    octree: &Octree,
+    params: PlieParams,
+    progress: &dyn Progress,
+    stage: &str,
+    prior: Option<Prior>,
+) -> Round {
     let tol = tolerance(scene, octree);
     let lights = scene.lights.len();
     let abs_scale = octree.root_bounds().min.abs().max(octree.root_bounds().max.abs()).max_element();
     let tols = Tolerances::new(tol, abs_scale);
     let propagate = params.propagation && params.regions;
     let order = propagation::task_order(scene, octree, propagate);
-    let states = FaceStates::new(scene, octree, tol);
+    let mut states = FaceStates::new(scene, octree, tol);
+    let mut propagator = Propagator::new(scene, octree, tols);
+    let mut reused: Vec<Option<TaskRecords>> = Vec::new();
+    if let Some(Prior { round, origin }) = prior {
+        // Kept leaves start with their final states and records; their propagated faces stay logged.
+        let mut new_of = vec![None; round.tasks.len() / lights.max(1)];
+        for (new, old) in origin.iter().enumerate() {
+            if let Some(old) = old {
+                new_of[old.idx()] = Some(LeafId(new as u32));
+                for face in Dir::ALL {
+                    for i in 0..lights as u32 {
+                        let light = LightId(i);
+                        states.set(LeafId(new as u32), face, light, round.states.get(*old, face, light));
+                    }
+                }
+            }
+        }
+        propagator.log = round
+            .propagator_log
+            .iter()
+            .filter_map(|p| new_of[p.leaf.idx()].map(|leaf| Propagated { leaf, ..*p }))
+            .collect();
+        let mut old_tasks: Vec<Option<TaskRecords>> = round.tasks.into_iter().map(Some).collect();
+        reused = origin
+            .iter()
+            .flat_map(|o| (0..lights).map(move |i| o.map(|old| old.idx() * lights + i)))
+            .map(|k| k.and_then(|k| old_tasks[k].take()))
+            .collect();
+    }
     let initial = states.clone();
     // Set at the commit that deletes a face: workers skip it (a face deleted later is computed anyway,
     // and its result discarded at its own commit).
     let deleted: Vec<AtomicBool> = (0..states.len()).map(|_| AtomicBool::new(false)).collect();
     let mut commits = Commits {
         states,
-        propagator: Propagator::new(scene, octree, tols),
-        tasks: (0..octree.leaf_count() * lights).map(|_| TaskRecords::default()).collect(),
+        propagator,
+        tasks: (0..octree.leaf_count() * lights)
+            .map(|k| reused.get_mut(k).and_then(Option::take).unwrap_or_default())
+            .collect(),
         lights,
         propagate,
         seconds: 0.0,
@@ -172,7 +372,7 @@ pub fn build_traced(scene: &Scene, octree: &Octree, params: PlieParams, progress
     let scratches: Vec<Mutex<GatherScratch>> = (0..rayon::current_num_threads().max(1))
         .map(|_| Mutex::new(GatherScratch::new(scene.triangles.len())))
         .collect();
-    progress.start("blockers", order.len() as u64);
+    progress.start(stage, order.len() as u64);
     schedule::run_ordered(
         order.len(),
         // Stages 2-5 for the task's faces that are pending and not deleted yet.
@@ -193,30 +393,8 @@ pub fn build_traced(scene: &Scene, octree: &Octree, params: PlieParams, progress
         |k, out| commits.commit(order[k], out, &deleted),
     );
     progress.finish();
-    let Commits { states, propagator, tasks, seconds: propagation_seconds, wasted, .. } = commits;
-
-    let mut stats = BuildStats {
-        leaves: octree.leaf_count(),
-        faces_considered: octree.leaf_count() * 6 * lights,
-        propagation_wasted: wasted,
-        propagation_seconds,
-        ..Default::default()
-    };
-    let plie = flatten(octree, params, lights, tasks, &mut stats);
-    stats.propagation_tests = propagator.tests;
-    let propagated = propagator.log;
-    stats.records_removed_propagation = propagated.len();
-    debug_assert_eq!(propagated.len(), states.propagated());
-    for p in &propagated {
-        *stats.propagation_by_rule.entry(p.rule.name()).or_default() += 1;
-    }
-    stats.no_record_face_cannot_see_light =
-        stats.faces_considered - stats.records - stats.records_removed_umbra - stats.records_removed_propagation;
-    let threads = rayon::current_num_threads().max(1) as f64;
-    stats.propagation_seconds_saved_estimate =
-        stats.records_removed_propagation as f64 * stats.record_seconds_mean / threads - propagation_seconds;
-    stats.blockers_seconds = t0.elapsed().as_secs_f64();
-    Built { plie, stats, propagated }
+    let Commits { states, propagator, tasks, seconds, wasted, .. } = commits;
+    Round { tasks, states, propagator_log: propagator.log, tests: propagator.tests, wasted, seconds }
 }
 
 /// What the commits own, in task order: the faces' states, the propagator and the results.
@@ -287,6 +465,7 @@ fn flatten(
         cell_blockers: Vec::new(),
         regions: Vec::new(),
         region_tris: Vec::new(),
+        splits: Vec::new(),
     };
     let (mut task_seconds, mut computed) = (0.0, 0);
     for t in &tasks {

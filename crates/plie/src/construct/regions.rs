@@ -183,6 +183,11 @@ pub struct FaceRegions {
 }
 
 impl FaceRegions {
+    /// The margin in face units (see [`FaceRegions::margin_world`]).
+    pub fn margin_units(&self) -> f64 {
+        self.margin
+    }
+
     /// True if the square `[lo, hi]` (units), grown by the margin, lies inside the umbra: used to
     /// classify face-grid cells.
     pub fn square_in_umbra(&self, lo: DVec2, hi: DVec2) -> bool {

@@ -13,7 +13,8 @@
 //! The payload holds the build parameters, a fingerprint of the scene's geometry, materials and lights,
 //! a fingerprint of the octree the P-LIE was built on, and the P-LIE. The octree itself is not stored:
 //! it is a deterministic function of the scene and the parameters, and is rebuilt on load (a fraction
-//! of the P-LIE's build time); its fingerprint proves it is the same one. Every way a file can be wrong
+//! of the P-LIE's build time), then refined by replaying the P-LIE's list of split nodes (SPEC §4.8);
+//! its fingerprint proves it is the same one. Every way a file can be wrong
 //! (another format, another version, truncated, corrupted, another scene, other parameters, an
 //! inconsistent structure) is an error, never a panic. Writes are atomic.
 
@@ -31,7 +32,7 @@ use crate::scene::Scene;
 /// First bytes of every `.plie` file.
 pub const MAGIC: [u8; 8] = *b"PLIE\r\n\x1a\n";
 /// Version of the layout written by this build of plie.
-pub const FORMAT_VERSION: u32 = 3;
+pub const FORMAT_VERSION: u32 = 4;
 const HEADER: usize = 8 + 4 + 8 + 8;
 
 /// What a `.plie` file holds after its header.
@@ -149,12 +150,16 @@ pub fn load_plie(path: &Path, scene: &Scene, expect: Option<PlieParams>) -> Resu
         return Err(bad(format!("was built for another scene, not '{}' (rebuild it with `plie build`)", scene.name)));
     }
     if let Some(p) = expect {
-        if p.octree() != body.params.octree() {
+        if p.octree() != body.params.octree() || p.refine != body.params.refine {
             return Err(bad(format!("was built with other parameters ({:?}) than asked for ({p:?})", body.params)));
         }
     }
     body.params.octree().validate().map_err(|e| bad(format!("invalid parameters in file: {e}")))?;
-    let octree = Octree::build(scene, body.params.octree());
+    body.params.refine.validate(body.params.regions).map_err(|e| bad(format!("invalid parameters in file: {e}")))?;
+    let mut octree = Octree::build(scene, body.params.octree());
+    for round in &body.plie.splits {
+        octree = octree.split_nodes(scene, round).map_err(|e| bad(format!("inconsistent .plie file: {e}")))?;
+    }
     if octree_fingerprint(&octree) != body.octree_fingerprint {
         return Err(bad("its octree differs from the one this plie builds for the scene: rebuild it".into()));
     }

@@ -9,6 +9,7 @@
 
 use serde::{Deserialize, Serialize};
 
+use crate::construct::refine::RefineParams;
 use crate::construct::regions::Tri2;
 use crate::octree::{Dir, LeafId};
 use crate::scene::{LightId, TriId};
@@ -32,6 +33,9 @@ pub struct PlieParams {
     /// faces proven dark by a fully dark neighbour without computing their blockers. Only speeds up
     /// construction; needs `regions` (without them no face is known to be dark).
     pub propagation: bool,
+    /// Refinement of the octree after the records are known (SPEC §4.8); off by default, as in the
+    /// thesis' test 1.
+    pub refine: RefineParams,
 }
 
 impl PlieParams {
@@ -46,6 +50,7 @@ impl PlieParams {
             grids: false,
             regions: true,
             propagation: true,
+            refine: RefineParams::none(),
         }
     }
 
@@ -138,6 +143,9 @@ pub struct Plie {
     pub regions: Vec<RecordRegions>,
     /// All region triangles, concatenated.
     pub region_tris: Vec<Tri2>,
+    /// The refinement (SPEC §4.8): per round, the nodes of the leaves split, in order (see
+    /// [`crate::octree::Octree::split_nodes`]). Empty without refinement.
+    pub splits: Vec<Vec<u32>>,
 }
 
 impl Plie {

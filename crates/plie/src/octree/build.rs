@@ -136,7 +136,7 @@ impl Octree {
 }
 
 /// Distributes a cell's triangles over its 8 children (each list keeps the parent's order).
-fn split_cell(scene: &Scene, tris: &[TriId], cell: &Aabb, eps: f32) -> Split {
+pub(super) fn split_cell(scene: &Scene, tris: &[TriId], cell: &Aabb, eps: f32) -> Split {
     let grown: [Aabb; 8] = std::array::from_fn(|i| child_box(cell, i).expanded(eps));
     let center = cell.center();
     if tris.len() <= PAR_CHUNK {

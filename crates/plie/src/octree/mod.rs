@@ -16,15 +16,18 @@
 //! - `node_bounds[n]` is the box of node `n`; every box is computed from its parent's by [`child_box`],
 //!   so neighbouring cells share their faces bit for bit.
 //! - `leaves[l]` holds the leaf's node, depth and a range into `leaf_tris`, the concatenation of all
-//!   leaf triangle lists. Each list is sorted by ascending [`TriId`]. Leaves are numbered breadth-first.
+//!   leaf triangle lists. Each list is sorted by ascending [`TriId`]. Leaves are numbered breadth-first
+//!   (after [`refine`], the children of split leaves follow the others).
 //!
 //! Stages: [`build`] (construction), [`locate`] (point location), [`traverse`] (segments and boxes),
-//! [`neighbour`] (face, edge and corner neighbours), [`validate`] (invariant report).
+//! [`neighbour`] (face, edge and corner neighbours), [`refine`] (splitting chosen leaves, §4.8),
+//! [`validate`] (invariant report).
 
 pub mod build;
 pub mod dir;
 pub mod locate;
 pub mod neighbour;
+pub mod refine;
 pub mod traverse;
 pub mod validate;
 
@@ -198,7 +201,7 @@ impl Octree {
         self.nodes.len()
     }
 
-    /// All leaf ids, in breadth-first order.
+    /// All leaf ids, in breadth-first order (refined leaves last, see [`refine`]).
     pub fn leaves(&self) -> impl ExactSizeIterator<Item = LeafId> + Clone {
         (0..self.leaves.len() as u32).map(LeafId)
     }

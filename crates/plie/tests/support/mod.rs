@@ -4,8 +4,10 @@
 
 use std::path::{Path, PathBuf};
 
-use glam::Vec3;
-use plie::Scene;
+use glam::{Vec2, Vec3};
+use plie::octree::{LeafId, Octree};
+use plie::visibility::ShadowRay;
+use plie::{LightId, Scene, TriId};
 
 /// splitmix64: deterministic, seedable, no dependency.
 pub struct TestRng(pub u64);
@@ -90,6 +92,15 @@ pub struct Built {
 }
 
 impl Built {
+    /// Built with `params` plus face grids, refining the octree if `params.refine` asks.
+    pub fn refined(scene: &Scene, params: plie::lie::PlieParams) -> Built {
+        let params = plie::lie::PlieParams { grids: true, ..params };
+        let bvh = plie::visibility::bvh::Bvh::build(scene);
+        let octree = plie::octree::Octree::build(scene, params.octree());
+        let b = plie::construct::build_refined(scene, octree, params, &plie::render::NoProgress);
+        Built { bvh, octree: b.octree, plie: b.plie }
+    }
+
     pub fn new(scene: &Scene, params: plie::lie::PlieParams) -> Built {
         let params = plie::lie::PlieParams { grids: true, ..params };
         let bvh = plie::visibility::bvh::Bvh::build(scene);
@@ -105,4 +116,48 @@ impl Built {
     ) -> Box<dyn plie::visibility::Visibility + 'a> {
         plie::visibility::for_mode(mode, scene, &self.bvh, &self.octree, Some(&self.plie)).unwrap()
     }
+}
+
+/// A shading-like start point: on a triangle, on a leaf's face/edge/corner, or anywhere.
+pub fn start_point(scene: &Scene, octree: &Octree, rng: &mut TestRng) -> (Vec3, TriId) {
+    let b = scene.bounds;
+    match rng.below(4) {
+        0 | 1 => {
+            let t = rng.below(scene.triangles.len());
+            let (mut u, mut v) = (rng.f32(), rng.f32());
+            if u + v > 1.0 {
+                (u, v) = (1.0 - u, 1.0 - v);
+            }
+            (scene.triangles[t].point(u, v), TriId(t as u32))
+        }
+        2 => {
+            let c = octree.leaf_bounds(LeafId(rng.below(octree.leaf_count()) as u32));
+            let mut p = rng.point_in(c.min, c.max);
+            for k in 0..3 {
+                match rng.below(3) {
+                    0 => p[k] = c.min[k],
+                    1 => p[k] = c.max[k],
+                    _ => {}
+                }
+            }
+            (p, TriId(u32::MAX))
+        }
+        _ => (rng.point_in(b.min, b.max), TriId(u32::MAX)),
+    }
+}
+
+/// Shadow rays: `y` uniform on a light, `x` strictly in front of it.
+pub fn shadow_rays(scene: &Scene, octree: &Octree, n: usize, seed: u64) -> Vec<ShadowRay> {
+    let mut rng = TestRng(seed);
+    let mut out = Vec::with_capacity(n);
+    while out.len() < n {
+        let li = rng.below(scene.lights.len());
+        let light = &scene.lights[li];
+        let y = light.sample(Vec2::new(rng.f32(), rng.f32()));
+        let (x, tri) = start_point(scene, octree, &mut rng);
+        if (x - y).dot(light.normal) > 0.0 {
+            out.push(ShadowRay::new(x, y, LightId(li as u32), tri, octree.locate(x)));
+        }
+    }
+    out
 }
