@@ -1,16 +1,17 @@
 //! `plie bench`: the thesis' measurement protocol (SPEC §7, Chapter 8) run in-process. For each scene:
 //! P-LIE construction with the thesis' test-1 parameters (umbra/penumbra included), with face grids,
-//! and without regions (Table 8.4); shading time of the
-//! hit buffer (pass 2 alone) for every visibility mode but brute, at the thesis' image settings;
-//! shadow-ray throughput with one thread and with all; and the break-even number of images. The
-//! files are written by [`crate::bench_report`].
-//!
-//! Refinement (the thesis' test 2) does not exist yet, so it is not measured.
+//! without regions (Table 8.4), without propagation, and refined by umbra with at most 2 splits (the
+//! thesis' test 2, Table 8.3's second rows; with and without face grids); shading time of the hit
+//! buffer (pass 2 alone) for every visibility mode but brute, and for the P-LIE modes on the refined
+//! P-LIE (the "+u" columns of Tables A.1-A.3), at the thesis' image settings; shadow-ray throughput
+//! with one thread and with all; and the break-even number of images. The files are written by
+//! [`crate::bench_report`].
 
 use std::path::PathBuf;
 use std::time::Instant;
 
 use anyhow::{Context, Result};
+use plie::construct::refine::RefineParams;
 use plie::lie::{Plie, PlieParams};
 use plie::octree::Octree;
 use plie::render::shade::shade;
@@ -59,6 +60,8 @@ pub struct Plan {
     pub shadow_rays: Vec<u32>,
     pub runs: usize,
     pub modes: Vec<Mode>,
+    /// The modes also measured on the refined P-LIE (those that use a P-LIE).
+    pub refined_modes: Vec<Mode>,
 }
 
 impl Plan {
@@ -71,8 +74,9 @@ impl Plan {
             (true, false) => builtin::NAMES.iter().map(|s| s.to_string()).collect(),
         };
         let (sizes, shadow_rays) = if a.quick { (vec![32], vec![4]) } else { (vec![126, 254], vec![4, 9]) };
-        let modes = Mode::ALL.into_iter().filter(|m| *m != Mode::Brute).collect();
-        Ok(Plan { scenes, sizes, shadow_rays, runs, modes })
+        let modes: Vec<Mode> = Mode::ALL.into_iter().filter(|m| *m != Mode::Brute).collect();
+        let refined_modes = modes.iter().copied().filter(|m| m.needs_plie()).collect();
+        Ok(Plan { scenes, sizes, shadow_rays, runs, modes, refined_modes })
     }
 
     /// The setting of the break-even figures: the largest image with the fewest shadow rays (254/4).
@@ -87,7 +91,8 @@ impl Plan {
 
     fn steps_per_scene(&self) -> u64 {
         let m = self.modes.len() as u64;
-        1 + m * (self.sizes.len() * self.shadow_rays.len()) as u64 + m
+        let settings = (self.sizes.len() * self.shadow_rays.len()) as u64;
+        1 + m * settings + m + self.refined_modes.len() as u64 * settings
     }
 }
 
@@ -124,7 +129,9 @@ pub struct SceneResult {
 #[derive(Serialize)]
 pub struct BuildResult {
     /// "thesis" (`PlieParams::thesis()`), "grids" (`PlieParams::default()`), "blockers-only" (the
-    /// thesis' parameters without regions) or "no-propagation" (the thesis' without propagation).
+    /// thesis' parameters without regions), "no-propagation" (the thesis' without propagation),
+    /// "refined" (the thesis' refined by umbra, at most 2 splits: test 2) or "refined-grids" (the
+    /// same with face grids).
     pub config: &'static str,
     pub seconds: f64,
     pub leaves: usize,
@@ -139,6 +146,8 @@ pub struct BuildResult {
 #[derive(Serialize)]
 pub struct Shading {
     pub mode: Mode,
+    /// On the refined P-LIE (and its refined octree): the thesis' "+u" columns.
+    pub refined: bool,
     pub size: u32,
     pub shadow_rays: u32,
     pub threads: usize,
@@ -157,6 +166,8 @@ pub struct Shading {
 #[derive(Serialize)]
 pub struct BreakEven {
     pub mode: Mode,
+    /// `mode` on the refined P-LIE, its build cost the refined construction.
+    pub refined: bool,
     pub against: Mode,
     pub images: Option<u64>,
 }
@@ -228,8 +239,9 @@ fn build_plie(
     params: PlieParams,
     config: &'static str,
     runs: usize,
-) -> (Plie, BuildResult) {
-    let ((plie, s), seconds) = timed(runs, || plie::construct::build(scene, octree, params, &NoProgress));
+) -> (Octree, Plie, BuildResult) {
+    let (b, seconds) = timed(runs, || plie::construct::build_refined(scene, octree.clone(), params, &NoProgress));
+    let s = b.stats;
     let r = BuildResult {
         config,
         seconds,
@@ -240,7 +252,7 @@ fn build_plie(
         blockers_mean: s.blockers_mean,
         blockers_max: s.blockers_max,
     };
-    (plie, r)
+    (b.octree, b.plie, r)
 }
 
 fn bench_scene(name: &str, plan: &Plan, one: &rayon::ThreadPool, bar: &Bar) -> Result<SceneResult> {
@@ -249,14 +261,19 @@ fn bench_scene(name: &str, plan: &Plan, one: &rayon::ThreadPool, bar: &Bar) -> R
     let thesis = PlieParams::thesis();
     thesis.octree().validate()?;
     let (octree, octree_seconds) = timed(plan.runs, || Octree::build(&scene, thesis.octree()));
-    let (lie, b1) = build_plie(&scene, &octree, thesis, "thesis", plan.runs);
-    let (grid, b2) = build_plie(&scene, &octree, PlieParams::default(), "grids", plan.runs);
+    let (_, lie, b1) = build_plie(&scene, &octree, thesis, "thesis", plan.runs);
+    let (_, grid, b2) = build_plie(&scene, &octree, PlieParams::default(), "grids", plan.runs);
     let no_regions = PlieParams { regions: false, ..thesis };
-    let (_, b3) = build_plie(&scene, &octree, no_regions, "blockers-only", plan.runs);
+    let (_, _, b3) = build_plie(&scene, &octree, no_regions, "blockers-only", plan.runs);
     let no_propagation = PlieParams { propagation: false, ..thesis };
-    let (_, b4) = build_plie(&scene, &octree, no_propagation, "no-propagation", plan.runs);
+    let (_, _, b4) = build_plie(&scene, &octree, no_propagation, "no-propagation", plan.runs);
+    let refined = PlieParams { refine: RefineParams::thesis_umbra(), ..thesis };
+    let (r_octree, r_lie, b5) = build_plie(&scene, &octree, refined, "refined", plan.runs);
+    let (_, r_grid, b6) =
+        build_plie(&scene, &octree, PlieParams { grids: true, ..refined }, "refined-grids", plan.runs);
     bar.advance(1);
     let s = Structures { scene: &scene, bvh: &bvh, octree: &octree, lie: &lie, grid: &grid };
+    let r = Structures { scene: &scene, bvh: &bvh, octree: &r_octree, lie: &r_lie, grid: &r_grid };
     let mut shading = Vec::new();
     let mut single = Vec::new();
     for &size in &plan.sizes {
@@ -272,8 +289,20 @@ fn bench_scene(name: &str, plan: &Plan, one: &rayon::ThreadPool, bar: &Bar) -> R
                 }
             }
         }
+        // The refined octree has other leaves: its own hit buffer (the same points and normals).
+        let hits = HitBuffer::build(&scene, &camera, (size, size, 1), &bvh, Some(&r_octree));
+        for &mode in &plan.refined_modes {
+            let vis = r.visibility(mode)?;
+            for &n in &plan.shadow_rays {
+                let mut row = time_shading(&scene, &hits, vis.as_ref(), (mode, size, n), plan.runs);
+                row.refined = true;
+                shading.push(row);
+                bar.advance(1);
+            }
+        }
     }
-    let break_even = break_even(plan, &shading, (octree_seconds, bvh_seconds), (b1.seconds, b2.seconds));
+    let builds = [(b1.seconds, b2.seconds), (b5.seconds, b6.seconds)];
+    let break_even = break_even(plan, &shading, (octree_seconds, bvh_seconds), builds);
     shading.extend(single);
     Ok(SceneResult {
         name: scene.name.clone(),
@@ -281,7 +310,7 @@ fn bench_scene(name: &str, plan: &Plan, one: &rayon::ThreadPool, bar: &Bar) -> R
         lights: scene.lights.len(),
         bvh_seconds,
         octree_seconds,
-        builds: vec![b1, b2, b3, b4],
+        builds: vec![b1, b2, b3, b4, b5, b6],
         shading,
         break_even,
     })
@@ -318,6 +347,7 @@ fn time_shading(
     let per_ray = |n: u64| n as f64 / stats.shadow_rays.max(1) as f64;
     Shading {
         mode,
+        refined: false,
         size,
         shadow_rays: n,
         threads,
@@ -331,21 +361,28 @@ fn time_shading(
     }
 }
 
-/// Break-even at the plan's break-even setting for lie and grid against octree and bvh. Costs: octree
-/// mode = octree build; bvh = BVH build; lie/grid = octree build + P-LIE build (thesis / with grids).
+/// Break-even at the plan's break-even setting for lie and grid, unrefined and refined, against
+/// octree and bvh. Costs: octree mode = octree build; bvh = BVH build; lie/grid = octree build +
+/// P-LIE build (thesis / with grids; refined: the refined constructions).
 fn break_even(
     plan: &Plan,
     shading: &[Shading],
     (octree_s, bvh_s): (f64, f64),
-    (lie_s, grid_s): (f64, f64),
+    builds: [(f64, f64); 2],
 ) -> Vec<BreakEven> {
     let (size, n) = plan.break_even_setting();
-    let t = |m: Mode| shading.iter().find(|r| r.mode == m && r.size == size && r.shadow_rays == n).map(|r| r.seconds);
+    let t = |m: Mode, refined: bool| {
+        let row = shading.iter().find(|r| r.mode == m && r.refined == refined && r.size == size && r.shadow_rays == n);
+        row.map(|r| r.seconds)
+    };
     let mut out = Vec::new();
-    for (mode, build) in [(Mode::Lie, octree_s + lie_s), (Mode::Grid, octree_s + grid_s)] {
-        for (against, other_build) in [(Mode::Octree, octree_s), (Mode::Bvh, bvh_s)] {
-            let (Some(tm), Some(ta)) = (t(mode), t(against)) else { continue };
-            out.push(BreakEven { mode, against, images: images_to_break_even(build, tm, other_build, ta) });
+    for (refined, (lie_s, grid_s)) in [false, true].into_iter().zip(builds) {
+        for (mode, build) in [(Mode::Lie, octree_s + lie_s), (Mode::Grid, octree_s + grid_s)] {
+            for (against, other_build) in [(Mode::Octree, octree_s), (Mode::Bvh, bvh_s)] {
+                let (Some(tm), Some(ta)) = (t(mode, refined), t(against, false)) else { continue };
+                let images = images_to_break_even(build, tm, other_build, ta);
+                out.push(BreakEven { mode, refined, against, images });
+            }
         }
     }
     out

@@ -1,4 +1,4 @@
-//! The files of `plie bench`: report.md (our figures beside the thesis' Tables 8.1, 8.3, 8.4 and A.1-A.4),
+//! The files of `plie bench`: report.md (our figures beside the thesis' Tables 8.1-8.4 and A.1-A.4),
 //! results.csv, results.json and the chart shading.svg ([`crate::bench_chart`]). Every file is written
 //! atomically.
 
@@ -41,7 +41,13 @@ impl Thesis {
 
     /// Test-1 shading seconds (umbra data built, not refined: the data of Table 8.1).
     fn shading(&self, scene: &str, method: &str, size: u32, rays: u32) -> Option<f64> {
-        let key = (thesis_name(scene), method.to_string(), rays, "yes".to_string(), size, "no".to_string());
+        self.shading_of(scene, method, size, rays, false)
+    }
+
+    /// Shading seconds with umbra data, refined (test 2, the "+ u" columns) or not (test 1).
+    fn shading_of(&self, scene: &str, method: &str, size: u32, rays: u32, refined: bool) -> Option<f64> {
+        let refined = if refined { "yes" } else { "no" }.to_string();
+        let key = (thesis_name(scene), method.to_string(), rays, "yes".to_string(), size, refined);
         self.shading.get(&key).copied()
     }
 
@@ -99,7 +105,7 @@ fn csv(r: &Results) -> String {
                 "shading,{},{},{},{},{},{},{},{},{},{},{},{},{}",
                 sc.name,
                 sc.triangles,
-                x.mode,
+                mode_label(x.mode, x.refined),
                 x.size,
                 x.shadow_rays,
                 x.threads,
@@ -152,7 +158,11 @@ fn header(s: &mut String, plan: &Plan, r: &Results) {
         settings.join(" and "),
         rays.join(" and ")
     );
-    let _ = writeln!(s, "- not measured: refinement (thesis test 2, Table 8.2) is not implemented yet.\n");
+    let _ = writeln!(
+        s,
+        "- `+u`: on the P-LIE refined by umbra (rules 1 and 2), at most 2 splits (the thesis' test 2), with its \
+         refined octree; the weights of its speed-ups are the unrefined octree mode's times, as in the thesis.\n"
+    );
 }
 
 fn construction(s: &mut String, r: &Results, th: Option<&Thesis>) {
@@ -162,21 +172,24 @@ fn construction(s: &mut String, r: &Results, th: Option<&Thesis>) {
         "P-LIE construction alone (octree excluded), median seconds. `blockers only`: 200 triangles per \
          leaf, no umbra/penumbra (Table 8.4); `regions`: with umbra/penumbra, removal of fully dark \
          records and propagation of umbra (test 1, Table 8.3 \"full\"); `no propagation`: the same \
-         without propagation; `+ grids`: `regions` with face grids (mode grid). Records removed: fully \
-         dark (of those, deleted by propagation without computing them).\n"
+         without propagation; `+ grids`: `regions` with face grids (mode grid); `refined`: `regions` \
+         refined by umbra, at most 2 splits (test 2, Table 8.3's second rows), with its leaves and \
+         records; `refined + grids`: the same with face grids. Records removed: fully dark (of those, \
+         deleted by propagation without computing them).\n"
     );
-    let mut head = "| scene | triangles | lights | octree s | leaves | records (removed dark; by propagation) | blockers/record (max) | blockers only s | regions s | no propagation s | + grids s |".to_string();
-    let mut rule = "|---|---|---|---|---|---|---|---|---|---|---|".to_string();
+    let mut head = "| scene | triangles | lights | octree s | leaves | records (removed dark; by propagation) | blockers/record (max) | blockers only s | regions s | no propagation s | + grids s | refined s (leaves; records) | refined + grids s |".to_string();
+    let mut rule = "|---|---|---|---|---|---|---|---|---|---|---|---|---|".to_string();
     if th.is_some() {
-        head += " thesis 8.4 blockers-only s | thesis 8.3 full s (leaves) |";
-        rule += "---|---|";
+        head += " thesis 8.4 blockers-only s | thesis 8.3 full s (leaves) | thesis 8.3 refined s (leaves) |";
+        rule += "---|---|---|";
     }
     let _ = writeln!(s, "{head}\n{rule}");
     for sc in &r.scenes {
         let (b, g, o, np) = (&sc.builds[0], &sc.builds[1], &sc.builds[2], &sc.builds[3]);
+        let (rf, rg) = (&sc.builds[4], &sc.builds[5]);
         let _ = write!(
             s,
-            "| {} | {} | {} | {:.4} | {} | {} ({}; {}) | {:.1} ({}) | {:.4} | {:.4} | {:.4} | {:.4} |",
+            "| {} | {} | {} | {:.4} | {} | {} ({}; {}) | {:.1} ({}) | {:.4} | {:.4} | {:.4} | {:.4} | {:.4} ({}; {}) | {:.4} |",
             sc.name,
             sc.triangles,
             sc.lights,
@@ -190,32 +203,50 @@ fn construction(s: &mut String, r: &Results, th: Option<&Thesis>) {
             o.seconds,
             b.seconds,
             np.seconds,
-            g.seconds
+            g.seconds,
+            rf.seconds,
+            rf.leaves,
+            rf.records,
+            rg.seconds
         );
         if let Some(t) = th {
             let bo = t.construction(&sc.name, "blockers_only").map(|x| format!("{:.2}", x.0)).unwrap_or_default();
-            let full = t.construction(&sc.name, "full").map(|x| format!("{:.2} ({})", x.0, x.1)).unwrap_or_default();
-            let _ = write!(s, " {bo} | {full} |");
+            let with_leaves =
+                |c| t.construction(&sc.name, c).map(|x| format!("{:.2} ({})", x.0, x.1)).unwrap_or_default();
+            let _ = write!(s, " {bo} | {} | {} |", with_leaves("full"), with_leaves("refined"));
         }
         s.push('\n');
     }
     let total = |i: usize| r.scenes.iter().map(|sc| sc.builds[i].seconds).sum::<f64>();
     let _ = writeln!(
         s,
-        "| **total** | | | | | | | **{:.3}** | **{:.3}** | **{:.3}** | **{:.3}** |",
+        "| **total** | | | | | | | **{:.3}** | **{:.3}** | **{:.3}** | **{:.3}** | **{:.3}** | **{:.3}** |",
         total(2),
         total(0),
         total(3),
-        total(1)
+        total(1),
+        total(4),
+        total(5)
     );
     s.push('\n');
 }
 
-/// Median shading seconds of `mode` at (size, rays), all threads.
+/// Median shading seconds of `mode` at (size, rays) with `threads` threads, on the unrefined P-LIE.
 pub fn seconds(sc: &SceneResult, mode: Mode, size: u32, rays: u32, threads: usize) -> Option<f64> {
-    let row =
-        sc.shading.iter().find(|x| x.mode == mode && x.size == size && x.shadow_rays == rays && x.threads == threads);
+    seconds_of(sc, mode, false, size, rays, threads)
+}
+
+/// Median shading seconds of `mode` on the refined (`+u`) or unrefined P-LIE.
+pub fn seconds_of(sc: &SceneResult, mode: Mode, refined: bool, size: u32, rays: u32, threads: usize) -> Option<f64> {
+    let row = sc.shading.iter().find(|x| {
+        x.mode == mode && x.refined == refined && x.size == size && x.shadow_rays == rays && x.threads == threads
+    });
     row.map(|x| x.seconds)
+}
+
+/// A mode's column label: `lie`, or `lie+u` on the refined P-LIE.
+fn mode_label(mode: Mode, refined: bool) -> String {
+    format!("{mode}{}", if refined { "+u" } else { "" })
 }
 
 fn shading(s: &mut String, plan: &Plan, r: &Results, th: Option<&Thesis>) {
@@ -223,25 +254,29 @@ fn shading(s: &mut String, plan: &Plan, r: &Results, th: Option<&Thesis>) {
     for &size in &plan.sizes {
         for &rays in &plan.shadow_rays {
             let _ = writeln!(s, "### {size}x{size} eye rays, {rays} shadow rays per light\n");
+            let ours: Vec<(Mode, bool)> =
+                plan.modes.iter().map(|&m| (m, false)).chain(plan.refined_modes.iter().map(|&m| (m, true))).collect();
+            let theirs: Vec<(&str, bool)> =
+                THESIS_MODES.iter().map(|&m| (m, false)).chain(THESIS_MODES[1..].iter().map(|&m| (m, true))).collect();
             let mut head = String::from("| scene |");
-            for m in &plan.modes {
-                let _ = write!(head, " {m} s |");
+            for &(m, u) in &ours {
+                let _ = write!(head, " {} s |", mode_label(m, u));
             }
             if th.is_some() {
-                for m in THESIS_MODES {
-                    let _ = write!(head, " thesis {m} s |");
+                for &(m, u) in &theirs {
+                    let _ = write!(head, " thesis {m}{} s |", if u { "+u" } else { "" });
                 }
             }
-            let cols = plan.modes.len() + 1 + if th.is_some() { THESIS_MODES.len() } else { 0 };
+            let cols = ours.len() + 1 + if th.is_some() { theirs.len() } else { 0 };
             let _ = writeln!(s, "{head}\n|{}", "---|".repeat(cols));
             for sc in &r.scenes {
                 let _ = write!(s, "| {} |", sc.name);
-                for &m in &plan.modes {
-                    let _ = write!(s, " {} |", fmt_opt(seconds(sc, m, size, rays, r.threads), 4));
+                for &(m, u) in &ours {
+                    let _ = write!(s, " {} |", fmt_opt(seconds_of(sc, m, u, size, rays, r.threads), 4));
                 }
                 if let Some(t) = th {
-                    for m in THESIS_MODES {
-                        let _ = write!(s, " {} |", fmt_opt(t.shading(&sc.name, m, size, rays), 2));
+                    for &(m, u) in &theirs {
+                        let _ = write!(s, " {} |", fmt_opt(t.shading_of(&sc.name, m, size, rays, u), 2));
                     }
                 }
                 s.push('\n');
@@ -262,34 +297,50 @@ fn speed_ups(s: &mut String, plan: &Plan, r: &Results, th: Option<&Thesis>) {
     let _ = writeln!(s, "## Weighted speed-ups\n");
     let _ = writeln!(
         s,
-        "Table 8.1 style: `1 - sum(t_mode) / sum(t_octree)` over the scenes measured (the thesis' column \
-         over those of them it has).\n"
+        "Tables 8.1 and 8.2 style: `1 - sum(t_mode) / sum(t_octree)` over the scenes measured (the thesis' \
+         column over those of them it has), `t_octree` always the unrefined octree mode's time. Table 8.2 is \
+         the thesis' LIE+u column (its printed 126x126, 9 rays figure is 50.98%; its own Table A.2 gives \
+         the value here).\n"
     );
-    let others: Vec<Mode> = plan.modes.iter().copied().filter(|m| *m != Mode::Octree).collect();
+    let others: Vec<(Mode, bool)> = plan
+        .modes
+        .iter()
+        .copied()
+        .filter(|m| *m != Mode::Octree)
+        .map(|m| (m, false))
+        .chain(plan.refined_modes.iter().map(|&m| (m, true)))
+        .collect();
+    let theirs: [(&str, bool); 6] =
+        [("LIE", false), ("UMBRA", false), ("PENUMBRA", false), ("LIE", true), ("UMBRA", true), ("PENUMBRA", true)];
     let mut head = String::from("| setting |");
-    for m in &others {
-        let _ = write!(head, " {m} |");
+    for &(m, u) in &others {
+        let _ = write!(head, " {} |", mode_label(m, u));
     }
     if th.is_some() {
-        head += " thesis LIE | thesis UMBRA | thesis PENUMBRA |";
+        for (m, u) in theirs {
+            let _ = write!(head, " thesis {m}{} |", if u { "+u" } else { "" });
+        }
     }
-    let cols = others.len() + 1 + if th.is_some() { 3 } else { 0 };
+    let cols = others.len() + 1 + if th.is_some() { theirs.len() } else { 0 };
     let _ = writeln!(s, "{head}\n|{}", "---|".repeat(cols));
     for &size in &plan.sizes {
         for &rays in &plan.shadow_rays {
             let _ = write!(s, "| {size}x{size}, {rays} rays |");
-            let sum = |m: Mode| r.scenes.iter().filter_map(|sc| seconds(sc, m, size, rays, r.threads)).sum::<f64>();
-            let base = sum(Mode::Octree);
-            for &m in &others {
-                let _ = write!(s, " {:.1}% |", 100.0 * (1.0 - sum(m) / base));
+            let sum = |m: Mode, u: bool| {
+                r.scenes.iter().filter_map(|sc| seconds_of(sc, m, u, size, rays, r.threads)).sum::<f64>()
+            };
+            let base = sum(Mode::Octree, false);
+            for &(m, u) in &others {
+                let _ = write!(s, " {:.1}% |", 100.0 * (1.0 - sum(m, u) / base));
             }
             if let Some(t) = th {
-                for m in &THESIS_MODES[1..] {
+                for (m, u) in theirs {
                     let pairs: Vec<(f64, f64)> = r
                         .scenes
                         .iter()
                         .filter_map(|sc| {
-                            Some((t.shading(&sc.name, "OCTREE", size, rays)?, t.shading(&sc.name, m, size, rays)?))
+                            let octree = t.shading(&sc.name, "OCTREE", size, rays)?;
+                            Some((octree, t.shading_of(&sc.name, m, size, rays, u)?))
                         })
                         .collect();
                     let (o, l) = pairs.iter().fold((0.0, 0.0), |(a, b), (x, y)| (a + x, b + y));
@@ -311,13 +362,19 @@ fn break_even(s: &mut String, r: &Results) {
         "Images of {size}x{size} eye rays, {rays} shadow rays per light, after which octree + P-LIE build + \
          shading costs less than the other mode's build + shading (SPEC §4.2.1's goal).\n"
     );
-    let _ = writeln!(s, "| scene | lie vs octree | lie vs bvh | grid vs octree | grid vs bvh |\n|---|---|---|---|---|");
+    let pairs =
+        [(Mode::Lie, Mode::Octree), (Mode::Lie, Mode::Bvh), (Mode::Grid, Mode::Octree), (Mode::Grid, Mode::Bvh)];
+    let cols: Vec<(Mode, bool, Mode)> = [false, true].into_iter().flat_map(|u| pairs.map(|(m, a)| (m, u, a))).collect();
+    let mut head = String::from("| scene |");
+    for &(m, u, a) in &cols {
+        let _ = write!(head, " {} vs {a} |", mode_label(m, u));
+    }
+    let _ = writeln!(s, "{head}\n|{}", "---|".repeat(cols.len() + 1));
     for sc in &r.scenes {
         let _ = write!(s, "| {} |", sc.name);
-        for (m, a) in
-            [(Mode::Lie, Mode::Octree), (Mode::Lie, Mode::Bvh), (Mode::Grid, Mode::Octree), (Mode::Grid, Mode::Bvh)]
-        {
-            let cell = match sc.break_even.iter().find(|b| b.mode == m && b.against == a).map(|b| b.images) {
+        for &(m, u, a) in &cols {
+            let found = sc.break_even.iter().find(|b| b.mode == m && b.refined == u && b.against == a);
+            let cell = match found.map(|b| b.images) {
                 Some(Some(n)) => n.to_string(),
                 Some(None) => "never".to_string(),
                 None => String::new(),
@@ -343,7 +400,7 @@ fn throughput(s: &mut String, r: &Results) {
             let all = sc
                 .shading
                 .iter()
-                .find(|y| y.mode == x.mode && y.size == size && y.shadow_rays == rays && y.threads == t);
+                .find(|y| y.mode == x.mode && !y.refined && y.size == size && y.shadow_rays == rays && y.threads == t);
             let (m, pc) = all.map(|y| (y.mrays_per_second, y.mrays_per_second_per_core)).unwrap_or((0.0, 0.0));
             let _ = writeln!(s, "| {} | {} | {:.2} | {m:.2} | {pc:.2} |", sc.name, x.mode, x.mrays_per_second);
         }
