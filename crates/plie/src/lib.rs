@@ -6,7 +6,8 @@
 //! normal; angles in degrees at the API (fields named `_deg`), radians inside; radiance in linear RGB.
 //!
 //! The pipeline (see `ARCHITECTURE.md`): a validated [`Scene`], an [`octree::Octree`] over it, the
-//! P-LIE built by [`construct::build`], a [`visibility::Visibility`] mode, and [`render::render`]
+//! P-LIE built by [`construct::build`] (or [`construct::build_refined`], which also refines the
+//! octree, SPEC §4.8), a [`visibility::Visibility`] mode, and [`render::render`]
 //! (hit buffer, then shading). Every mode answers every shadow ray exactly as brute force.
 //!
 //! ```
