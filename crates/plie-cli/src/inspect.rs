@@ -12,10 +12,10 @@ use plie::inspect::summary::{FaceSummary, Filter, Summary};
 use plie::inspect::{FaceStatus, Inspection, Inspector};
 use plie::io::gltf_export::{save_inspection_gltf, GltfFormat};
 use plie::octree::{Dir, Octree};
-use plie::render::RenderSettings;
 use serde_json::{json, Value};
 
-use crate::plie_args::PlieArgs;
+use crate::image_args::ImageArgs;
+use crate::plie_args::{load_or_build, Loaded, PlieArgs};
 use crate::progress::Bar;
 use crate::scene_arg::{parse_vec3, SceneArgs};
 
@@ -50,24 +50,9 @@ pub struct Args {
     /// inspected leaf and the leaf fills about half of the picture (PNG and the glTF's camera).
     #[arg(long)]
     frame: bool,
-    /// PNG: width in pixels.
-    #[arg(long, default_value_t = 398)]
-    width: u32,
-    /// PNG: height in pixels.
-    #[arg(long, default_value_t = 398)]
-    height: u32,
-    /// PNG: K x K regular eye rays per pixel.
-    #[arg(long, default_value_t = 2, value_name = "K")]
-    eye_rays: u32,
-    /// PNG: N-rooks shadow rays per light per eye ray.
-    #[arg(long, default_value_t = 25, value_name = "N")]
-    shadow_rays: u32,
-    /// PNG: seed of the random streams.
-    #[arg(long, default_value_t = 0)]
-    seed: u64,
-    /// PNG: scale the scene's radiance by 2^EV (the overlay colours stay as they are).
-    #[arg(long, default_value_t = 0.0, value_name = "EV", allow_hyphen_values = true)]
-    exposure: f32,
+    /// The PNG's image settings.
+    #[command(flatten)]
+    image: ImageArgs,
     /// PNG: width of the leaf edges in pixels (the inspected leaf's are twice as wide).
     #[arg(long, default_value_t = 1.5, value_name = "PX")]
     line_width: f32,
@@ -116,17 +101,7 @@ pub fn run(a: &Args) -> Result<()> {
     }
     let kind = a.output.as_deref().map(output_kind).transpose()?;
     let face: Option<Dir> = a.face.as_deref().map(str::parse).transpose().map_err(anyhow::Error::msg)?;
-    let settings = RenderSettings {
-        width: a.width,
-        height: a.height,
-        eye_rays: a.eye_rays,
-        shadow_rays: a.shadow_rays,
-        seed: a.seed,
-    };
-    settings.validate()?;
-    if !a.exposure.is_finite() {
-        bail!("--exposure must be a finite number");
-    }
+    let settings = a.image.settings()?;
     if !(a.line_width.is_finite() && a.line_width > 0.0) {
         bail!("--line-width must be a positive number of pixels");
     }
@@ -138,14 +113,7 @@ pub fn run(a: &Args) -> Result<()> {
     let camera = a.scene.camera(&scene)?;
     let params = a.params.params(false)?;
     let bar = Bar::new(a.quiet || a.json);
-    let (octree, plie) = match &a.plie {
-        Some(path) => plie::io::plie_file::load_plie(path, &scene, Some(params))
-            .with_context(|| format!("cannot use P-LIE file {}", path.display()))?,
-        None => {
-            let built = plie::construct::build_refined(&scene, Octree::build(&scene, params.octree()), params, &bar);
-            (built.octree, built.plie)
-        }
-    };
+    let Loaded { octree, plie, .. } = load_or_build(&scene, params, a.plie.as_deref(), &bar)?;
     let inspector = Inspector::new(&scene, &octree, &plie)?;
     let light = a.light.map(|i| inspector.light(i)).transpose()?;
     let leaf = a.cell.map(|p| inspector.leaf_at(p)).transpose()?;
@@ -165,13 +133,13 @@ pub fn run(a: &Args) -> Result<()> {
         let camera = if a.frame { camera_on_box(&camera, &ins.bounds) } else { camera };
         match kind {
             Output::Png => {
-                let style = OverlayStyle { line_px: a.line_width, exposure_ev: a.exposure };
+                let style = OverlayStyle { line_px: a.line_width, exposure_ev: a.image.exposure };
                 let out = render_inspection(&scene, &octree, ins, &camera, &settings, &style, &bar)?;
-                plie::io::save_image(path, a.width, a.height, &out.pixels)
+                plie::io::save_image(path, a.image.width, a.image.height, &out.pixels)
                     .with_context(|| format!("cannot write {}", path.display()))?;
             }
             Output::Gltf => {
-                let aspect = a.width as f32 / a.height as f32;
+                let aspect = a.image.width as f32 / a.image.height as f32;
                 save_inspection_gltf(path, &scene, &octree, ins, Some((&camera, aspect)))
                     .with_context(|| format!("cannot write {}", path.display()))?;
             }

@@ -6,6 +6,7 @@ mod bench;
 mod bench_chart;
 mod bench_report;
 mod build;
+mod image_args;
 mod inspect;
 mod plie_args;
 mod progress;

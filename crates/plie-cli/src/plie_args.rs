@@ -2,10 +2,17 @@
 //! `--max-split-depth` and `--max-blockers`: the P-LIE build parameters (SPEC §4.9) shared by
 //! `plie build`, `plie render` and `plie inspect`.
 
-use anyhow::{bail, Result};
+use std::path::Path;
+use std::time::Instant;
+
+use anyhow::{bail, Context, Result};
 use plie::construct::refine::{MaxBlockers, RefineParams};
+use plie::lie::Plie;
 use plie::lie::PlieParams;
-use plie::octree::OctreeParams;
+use plie::octree::{Octree, OctreeParams};
+use plie::Scene;
+
+use crate::progress::Bar;
 
 /// Options that set the octree and P-LIE parameters.
 #[derive(clap::Args, Clone, Debug)]
@@ -98,4 +105,36 @@ impl PlieArgs {
             max_split_depth: self.max_split_depth,
         })
     }
+}
+
+/// An octree and its P-LIE, loaded from a file or built.
+pub struct Loaded {
+    /// The octree (refined if the P-LIE was).
+    pub octree: Octree,
+    /// The P-LIE.
+    pub plie: Plie,
+    /// Seconds building the P-LIE (octree excluded), when built.
+    pub build_seconds: Option<f64>,
+    /// Seconds loading the file (octree rebuilt included), when loaded.
+    pub load_seconds: Option<f64>,
+}
+
+/// Loads the P-LIE file `path` (checking it was built for `scene` with `params`), or builds the
+/// octree and the P-LIE (refined if `params` asks) when there is no file.
+pub fn load_or_build(scene: &Scene, params: PlieParams, path: Option<&Path>, bar: &Bar) -> Result<Loaded> {
+    let t = Instant::now();
+    if let Some(path) = path {
+        let (octree, plie) = plie::io::plie_file::load_plie(path, scene, Some(params))
+            .with_context(|| format!("cannot use P-LIE file {}", path.display()))?;
+        return Ok(Loaded { octree, plie, build_seconds: None, load_seconds: Some(t.elapsed().as_secs_f64()) });
+    }
+    let octree = Octree::build(scene, params.octree());
+    let t = Instant::now();
+    let built = plie::construct::build_refined(scene, octree, params, bar);
+    Ok(Loaded {
+        octree: built.octree,
+        plie: built.plie,
+        build_seconds: Some(t.elapsed().as_secs_f64()),
+        load_seconds: None,
+    })
 }

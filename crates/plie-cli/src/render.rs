@@ -7,12 +7,13 @@ use std::time::Instant;
 use anyhow::{Context, Result};
 use plie::octree::Octree;
 
-use plie::render::{render, RenderSettings};
+use plie::render::render;
 use plie::visibility::bvh::Bvh;
 use plie::visibility::{self, Answer, Mode, QueryStats};
 use serde_json::json;
 
-use crate::plie_args::PlieArgs;
+use crate::image_args::ImageArgs;
+use crate::plie_args::{load_or_build, PlieArgs};
 use crate::progress::Bar;
 use crate::scene_arg::SceneArgs;
 
@@ -24,26 +25,13 @@ pub struct Args {
     /// Output image; the extension picks the format: .png, .exr, .pfm.
     #[arg(short = 'o', long = "output", value_name = "OUT")]
     output: PathBuf,
-    /// Image width in pixels.
-    #[arg(long, default_value_t = 398)]
-    width: u32,
-    /// Image height in pixels.
-    #[arg(long, default_value_t = 398)]
-    height: u32,
-    /// K: K x K regular eye rays per pixel.
-    #[arg(long, default_value_t = 2, value_name = "K")]
-    eye_rays: u32,
-    /// N: N-rooks shadow rays per light per eye ray.
-    #[arg(long, default_value_t = 25, value_name = "N")]
-    shadow_rays: u32,
+    #[command(flatten)]
+    image: ImageArgs,
     /// Visibility method: brute (every triangle), octree (SPEC mode a), bvh (modern BVH), lie (P-LIE
     /// blockers, SPEC mode b), umbra (mode c), penumbra (mode d), grid (P-LIE face grids, ours),
     /// embree (with the embree feature). All give the same image.
     #[arg(long, default_value = "bvh", value_name = "MODE")]
     visibility: Mode,
-    /// Seed of the random streams (same seed, same image, in every exact mode).
-    #[arg(long, default_value_t = 0)]
-    seed: u64,
     /// Worker threads (default: all cores). Images do not depend on it.
     #[arg(long, value_name = "T")]
     threads: Option<usize>,
@@ -52,9 +40,6 @@ pub struct Args {
     /// Use this P-LIE file (from `plie build`) instead of building one (modes that need a P-LIE).
     #[arg(long, value_name = "FILE.plie")]
     plie: Option<PathBuf>,
-    /// PNG only: scale radiance by 2^EV before tone mapping (EXR and PFM keep the exact values).
-    #[arg(long, default_value_t = 0.0, value_name = "EV", allow_hyphen_values = true)]
-    exposure: f32,
     /// Print human-readable figures on stderr.
     #[arg(long)]
     stats: bool,
@@ -68,17 +53,7 @@ pub struct Args {
 
 pub fn run(a: &Args) -> Result<()> {
     crate::scenes::set_threads(a.threads)?;
-    let settings = RenderSettings {
-        width: a.width,
-        height: a.height,
-        eye_rays: a.eye_rays,
-        shadow_rays: a.shadow_rays,
-        seed: a.seed,
-    };
-    settings.validate()?;
-    if !a.exposure.is_finite() {
-        anyhow::bail!("--exposure must be a finite number");
-    }
+    let settings = a.image.settings()?;
     let t = Instant::now();
     let scene = a.scene.load()?;
     let load_seconds = t.elapsed().as_secs_f64();
@@ -95,35 +70,23 @@ pub fn run(a: &Args) -> Result<()> {
     // Face grids only serve mode `grid`: other modes skip building them.
     let params = a.params.params(a.visibility == Mode::Grid)?;
     let t = Instant::now();
-    let (octree, plie, plie_seconds, load_plie_seconds) = match (&a.plie, a.visibility.needs_plie()) {
-        (Some(path), true) => {
-            let (octree, plie) = plie::io::plie_file::load_plie(path, &scene, Some(params))
-                .with_context(|| format!("cannot use P-LIE file {}", path.display()))?;
-            (octree, Some(plie), None, Some(t.elapsed().as_secs_f64()))
-        }
-        (_, needs) => {
-            let octree = Octree::build(&scene, params.octree());
-            let t = Instant::now();
-            let (octree, plie) = if needs {
-                let built = plie::construct::build_refined(&scene, octree, params, &bar);
-                (built.octree, Some(built.plie))
-            } else {
-                (octree, None)
-            };
-            (octree, plie, needs.then(|| t.elapsed().as_secs_f64()), None)
-        }
+    let (octree, plie, plie_seconds, load_plie_seconds) = if a.visibility.needs_plie() {
+        let got = load_or_build(&scene, params, a.plie.as_deref(), &bar)?;
+        (got.octree, Some(got.plie), got.build_seconds, got.load_seconds)
+    } else {
+        (Octree::build(&scene, params.octree()), None, None, None)
     };
     let octree_seconds = t.elapsed().as_secs_f64() - plie_seconds.unwrap_or(0.0);
     let vis = visibility::for_mode(a.visibility, &scene, &bvh, &octree, plie.as_ref())?;
     let out = render(&scene, &camera, &settings, &bvh, Some(&octree), vis.as_ref(), &bar)?;
     let pixels = match plie::io::ImageFormat::from_path(&a.output)? {
-        plie::io::ImageFormat::Png if a.exposure != 0.0 => {
-            let k = a.exposure.exp2();
+        plie::io::ImageFormat::Png if a.image.exposure != 0.0 => {
+            let k = a.image.exposure.exp2();
             out.pixels.iter().map(|p| *p * k).collect()
         }
         _ => out.pixels,
     };
-    plie::io::save_image(&a.output, a.width, a.height, &pixels)
+    plie::io::save_image(&a.output, a.image.width, a.image.height, &pixels)
         .with_context(|| format!("cannot write {}", a.output.display()))?;
 
     let s = out.stats;
@@ -135,11 +98,11 @@ pub fn run(a: &Args) -> Result<()> {
             "triangles": scene.triangle_count(),
             "lights": scene.lights.len(),
             "visibility": a.visibility.name(),
-            "width": a.width,
-            "height": a.height,
-            "eye_rays": a.eye_rays,
-            "shadow_rays_per_light": a.shadow_rays,
-            "seed": a.seed,
+            "width": a.image.width,
+            "height": a.image.height,
+            "eye_rays": a.image.eye_rays,
+            "shadow_rays_per_light": a.image.shadow_rays,
+            "seed": a.image.seed,
             "threads": rayon::current_num_threads(),
             "load_seconds": load_seconds,
             "bvh_build_seconds": bvh_seconds,
@@ -176,7 +139,7 @@ pub fn run(a: &Args) -> Result<()> {
         eprintln!("visibility       {}", a.visibility);
         eprintln!(
             "image            {}x{}, {}x{} eye rays/pixel, {} shadow rays/light",
-            a.width, a.height, a.eye_rays, a.eye_rays, a.shadow_rays
+            a.image.width, a.image.height, a.image.eye_rays, a.image.eye_rays, a.image.shadow_rays
         );
         eprintln!("threads          {}", rayon::current_num_threads());
         eprintln!("load             {load_seconds:.3} s");
