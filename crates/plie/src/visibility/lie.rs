@@ -24,10 +24,58 @@ use crate::lie::{Cell, Plie};
 use crate::octree::{Dir, LeafId, Octree};
 use crate::scene::{Scene, TriId};
 
+/// Blockers per chunk of a long list (see [`ListBoxes`]).
+pub const CHUNK: usize = 8;
+
+/// Lists shorter than this are tested one box at a time.
+pub const CHUNKED_MIN: usize = 4 * CHUNK;
+
+/// The boxes of consecutive chunks of [`CHUNK`] blockers of every long list (SPEC §8 point 4): a ray
+/// tests a chunk's box before the boxes of its blockers, so it skips most of a long list whose
+/// triangles lie away from it. Built when the visibility is made (the P-LIE file is unchanged); a
+/// conservative cull, so answers do not change.
+#[derive(Default)]
+struct ListBoxes {
+    /// Per list: the index of its first chunk box in `boxes`, or `u32::MAX` for a short list.
+    first: Vec<u32>,
+    /// Chunk boxes (unions of the grown triangle boxes).
+    boxes: Vec<Aabb>,
+}
+
+impl ListBoxes {
+    /// Chunk boxes of the lists `ranges` (start, len) of `refs`.
+    fn new(ranges: impl Iterator<Item = (u32, u32)>, refs: &[TriId], tri_boxes: &[Aabb]) -> ListBoxes {
+        let mut out = ListBoxes::default();
+        for (start, len) in ranges {
+            if (len as usize) < CHUNKED_MIN || start == u32::MAX {
+                out.first.push(u32::MAX);
+                continue;
+            }
+            out.first.push(out.boxes.len() as u32);
+            let list = &refs[start as usize..(start + len) as usize];
+            for chunk in list.chunks(CHUNK) {
+                let b = chunk.iter().map(|t| tri_boxes[t.idx()]).reduce(Aabb::union).expect("a chunk is not empty");
+                out.boxes.push(b);
+            }
+        }
+        out
+    }
+
+    /// The chunk boxes of list `i` of `len` blockers (empty for a short list).
+    #[inline]
+    fn of(&self, i: usize, len: usize) -> &[Aabb] {
+        match self.first[i] {
+            u32::MAX => &[],
+            f => &self.boxes[f as usize..f as usize + len.div_ceil(CHUNK)],
+        }
+    }
+}
+
 /// Modes (b)-(d) and `grid`: the P-LIE's blocker lists, regions and face grids.
 ///
 /// Before a candidate gets the watertight test, its bounding box (grown by the construction tolerance)
-/// is tested against the segment: a conservative cull (SPEC §8 point 4) that never changes an answer.
+/// is tested against the segment, and in a long list the box of its chunk first ([`ListBoxes`]):
+/// conservative culls (SPEC §8 point 4) that never change an answer.
 pub struct LieVisibility<'a> {
     scene: &'a Scene,
     octree: &'a Octree,
@@ -38,6 +86,10 @@ pub struct LieVisibility<'a> {
     mode: Mode,
     /// Voxel grids over the leaves' own triangles.
     voxels: LeafVoxels,
+    /// Chunk boxes of the records' blocker lists.
+    record_boxes: ListBoxes,
+    /// Chunk boxes of the face-grid cells' lists.
+    cell_boxes: ListBoxes,
 }
 
 impl<'a> LieVisibility<'a> {
@@ -48,7 +100,14 @@ impl<'a> LieVisibility<'a> {
         let pad = scene.scale() * crate::construct::TOLERANCE_REL;
         let tri_boxes: Vec<Aabb> = scene.triangles.iter().map(|t| t.aabb().expanded(pad)).collect();
         let voxels = LeafVoxels::new(octree, &tri_boxes, pad);
-        LieVisibility { scene, octree, plie, tri_boxes, voxels, mode }
+        let records = plie.records.iter().map(|r| (r.blockers_start, r.blockers_len));
+        let record_boxes = ListBoxes::new(records, &plie.blockers, &tri_boxes);
+        let cell_boxes = if mode == Mode::Grid {
+            ListBoxes::new(plie.cells.iter().copied(), &plie.cell_blockers, &tri_boxes)
+        } else {
+            ListBoxes::default()
+        };
+        LieVisibility { scene, octree, plie, tri_boxes, voxels, mode, record_boxes, cell_boxes }
     }
 
     /// The box cull, then the shared predicate.
@@ -58,12 +117,27 @@ impl<'a> LieVisibility<'a> {
         seg.clip(&self.tri_boxes[t.idx()]).is_some() && blocks(self.scene, ray, t, ctx)
     }
 
-    /// True if a triangle of `list` blocks the ray (tested in order, stopping at the first), and the
-    /// number of triangle tests that took.
+    /// True if a triangle of `list` blocks the ray (tested in order, stopping at the first; with
+    /// `chunks`, only the chunks whose box the segment meets), and the number of triangle tests that
+    /// took.
     #[inline]
-    fn any_blocks(&self, seg: &Segment, ray: &ShadowRay, list: &[TriId], ctx: &mut QueryCtx) -> (bool, u64) {
+    fn any_blocks(
+        &self,
+        seg: &Segment,
+        ray: &ShadowRay,
+        list: &[TriId],
+        chunks: &[Aabb],
+        ctx: &mut QueryCtx,
+    ) -> (bool, u64) {
         let before = ctx.stats.triangle_tests;
-        let hit = list.iter().any(|&t| self.test(seg, ray, t, ctx));
+        let hit = if chunks.is_empty() {
+            list.iter().any(|&t| self.test(seg, ray, t, ctx))
+        } else {
+            list.chunks(CHUNK).zip(chunks).any(|(chunk, b)| {
+                ctx.stats.box_tests += 1;
+                seg.clip(b).is_some() && chunk.iter().any(|&t| self.test(seg, ray, t, ctx))
+            })
+        };
         (hit, ctx.stats.triangle_tests - before)
     }
 }
@@ -107,15 +181,18 @@ impl Visibility for LieVisibility<'_> {
                     return ctx.stats.answered(Answer::NoRecord, true);
                 };
                 let f = ray.test.origin + ray.test.dir * t_exit;
-                let record = || self.plie.blockers_of(&self.plie.records[ri]);
-                let list = match self.mode {
+                let record = || {
+                    let list = self.plie.blockers_of(&self.plie.records[ri]);
+                    (list, self.record_boxes.of(ri, list.len()))
+                };
+                let (list, chunks) = match self.mode {
                     Mode::Umbra | Mode::Penumbra => {
                         let x = FaceFrame::new(face, &self.octree.leaf_bounds(leaf)).units(f.as_dvec3());
                         if in_triangles(self.plie.umbra_of(ri), x) {
                             return ctx.stats.answered(Answer::Umbra, true);
                         }
                         if self.mode == Mode::Penumbra && !in_triangles(self.plie.penumbra_of(ri), x) {
-                            &[]
+                            (&[][..], &[][..])
                         } else {
                             record()
                         }
@@ -125,7 +202,9 @@ impl Visibility for LieVisibility<'_> {
                         let c = grid::cell_of(face, &self.octree.leaf_bounds(leaf), grid.res, f);
                         match self.plie.cell(grid, c) {
                             Cell::Umbra => return ctx.stats.answered(Answer::Umbra, true),
-                            Cell::Blockers(list) => list,
+                            Cell::Blockers(list) => {
+                                (list, self.cell_boxes.of(grid.cells_start as usize + c, list.len()))
+                            }
                         }
                     }
                     _ => record(),
@@ -133,7 +212,7 @@ impl Visibility for LieVisibility<'_> {
                 if list.is_empty() {
                     Answer::Lit
                 } else {
-                    let (hit, tests) = self.any_blocks(&seg, ray, list, ctx);
+                    let (hit, tests) = self.any_blocks(&seg, ray, list, chunks, ctx);
                     ctx.stats.blocker_tests += tests;
                     if hit {
                         return ctx.stats.answered(Answer::BlockersHit, true);
