@@ -88,7 +88,7 @@ fn blockers_contain_every_triangle_between_face_and_light() {
                 }
                 checked += 1;
                 assert!(
-                    blockers.binary_search(&plie::TriId(t as u32)).is_ok(),
+                    blockers.contains(&plie::TriId(t as u32)),
                     "triangle {t} lies between face {:?} of leaf {:?} and light {:?} but is not a blocker",
                     r.face,
                     r.leaf,

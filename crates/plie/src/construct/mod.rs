@@ -593,6 +593,13 @@ fn face_record(
         if let (Some(g), Some(reg)) = (grid.as_mut(), regions.as_ref().filter(|_| has_umbra)) {
             g.umbra = grid::umbra_cells(g.g, reg);
         }
+        // Long lists in Morton order, for the visibility's chunk boxes (answers do not depend on it).
+        let mut blockers = blockers;
+        for list in std::iter::once(&mut blockers).chain(grid.iter_mut().flat_map(|g| g.lists.iter_mut())) {
+            if list.len() >= crate::lie::CHUNKED_MIN {
+                crate::geometry::morton::sort_spatially(scene, list);
+            }
+        }
         (Some(PendingRecord { blockers, regions, grid }), FaceState::Kept)
     };
     FaceOut { record, state, candidates, seconds: t0.elapsed().as_secs_f64() }

@@ -1,11 +1,12 @@
 //! Geometry shared by every stage: boxes, triangles, the one watertight segment/triangle test and the
-//! exact triangle/box overlap test.
+//! exact triangle/box overlap test; the Morton order of long blocker lists.
 //!
 //! SPEC §3 (octree assignment needs the triangle/box test) and §5 (one watertight test everywhere, so
 //! every visibility mode answers the same shadow ray identically).
 
 pub mod aabb;
 pub mod clip;
+pub mod morton;
 pub mod ray_triangle;
 pub mod segment;
 pub mod tri_box;

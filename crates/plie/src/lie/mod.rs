@@ -5,7 +5,8 @@
 //! Layout: one `u32` per (leaf, face, light) in `record_index` (O(1) lookup, `NO_RECORD` where there is
 //! none), the records in one flat array, and all blocker lists concatenated in `blockers`. Parallel to
 //! the records: their umbra/penumbra triangles (§4.5, in the face's integer units, see
-//! [`crate::construct::regions::FaceFrame`]) and their face grids.
+//! [`crate::construct::regions::FaceFrame`]) and their face grids. Long blocker lists are stored in
+//! Morton order ([`CHUNKED_MIN`]).
 
 use serde::{Deserialize, Serialize};
 
@@ -13,6 +14,14 @@ use crate::construct::refine::RefineParams;
 use crate::construct::regions::Tri2;
 use crate::octree::{Dir, LeafId};
 use crate::scene::{LightId, TriId};
+
+/// Blocker lists (of records and of face-grid cells) with at least this many triangles are stored in
+/// Morton order ([`crate::geometry::morton::sort_spatially`]); shorter ones by ascending id.
+pub const CHUNKED_MIN: usize = 4 * CHUNK;
+
+/// Triangles per chunk when a shadow ray walks a long list: it tests a box around each chunk (and
+/// around each group of `CHUNK` chunks) first ([`crate::visibility::lie`]).
+pub const CHUNK: usize = 8;
 
 /// `record_index` entry for "no data object".
 pub const NO_RECORD: u32 = u32::MAX;

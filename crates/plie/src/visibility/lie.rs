@@ -20,55 +20,80 @@ use super::{blocks, Answer, Mode, OctreeVisibility, QueryCtx, ShadowRay, Visibil
 use crate::construct::grid;
 use crate::construct::regions::{in_triangles, FaceFrame};
 use crate::geometry::{Aabb, Segment};
-use crate::lie::{Cell, Plie};
+use crate::lie::{Cell, Plie, CHUNK, CHUNKED_MIN};
 use crate::octree::{Dir, LeafId, Octree};
 use crate::scene::{Scene, TriId};
 
-/// Blockers per chunk of a long list (see [`ListBoxes`]).
-pub const CHUNK: usize = 8;
-
-/// Lists shorter than this are tested one box at a time.
-pub const CHUNKED_MIN: usize = 4 * CHUNK;
-
-/// The boxes of consecutive chunks of [`CHUNK`] blockers of every long list (SPEC §8 point 4): a ray
-/// tests a chunk's box before the boxes of its blockers, so it skips most of a long list whose
-/// triangles lie away from it. Built when the visibility is made (the P-LIE file is unchanged); a
-/// conservative cull, so answers do not change.
+/// The boxes of consecutive chunks of [`CHUNK`] blockers of every long list, and of groups of
+/// [`CHUNK`] chunks (SPEC §8 point 4): a ray tests a group's box, then its chunks' boxes, before the
+/// boxes of their blockers, so it skips most of a long list whose triangles lie away from it. Long
+/// lists are stored in Morton order ([`crate::geometry::morton`]), so chunks are compact. Built when
+/// the visibility is made; conservative culls, so answers do not change.
 #[derive(Default)]
 struct ListBoxes {
     /// Per list: the index of its first chunk box in `boxes`, or `u32::MAX` for a short list.
     first: Vec<u32>,
     /// Chunk boxes (unions of the grown triangle boxes).
     boxes: Vec<Aabb>,
+    /// Per list: the index of its first group box in `groups` (`u32::MAX` for a short list).
+    first_group: Vec<u32>,
+    /// Boxes of groups of [`CHUNK`] consecutive chunks.
+    groups: Vec<Aabb>,
 }
 
 impl ListBoxes {
-    /// Chunk boxes of the lists `ranges` (start, len) of `refs`.
+    /// Chunk and group boxes of the lists `ranges` (start, len) of `refs`. Ranges may repeat (grid
+    /// cells share lists): a repeated range shares its boxes.
     fn new(ranges: impl Iterator<Item = (u32, u32)>, refs: &[TriId], tri_boxes: &[Aabb]) -> ListBoxes {
         let mut out = ListBoxes::default();
+        let mut seen: std::collections::HashMap<u32, (u32, u32)> = std::collections::HashMap::new();
         for (start, len) in ranges {
             if (len as usize) < CHUNKED_MIN || start == u32::MAX {
                 out.first.push(u32::MAX);
+                out.first_group.push(u32::MAX);
                 continue;
             }
-            out.first.push(out.boxes.len() as u32);
-            let list = &refs[start as usize..(start + len) as usize];
-            for chunk in list.chunks(CHUNK) {
-                let b = chunk.iter().map(|t| tri_boxes[t.idx()]).reduce(Aabb::union).expect("a chunk is not empty");
-                out.boxes.push(b);
-            }
+            let (f, g) = *seen.entry(start).or_insert_with(|| {
+                let (f, g) = (out.boxes.len(), out.groups.len());
+                let union = |it: &mut dyn Iterator<Item = Aabb>| it.reduce(Aabb::union).expect("not empty");
+                for chunk in refs[start as usize..(start + len) as usize].chunks(CHUNK) {
+                    out.boxes.push(union(&mut chunk.iter().map(|t| tri_boxes[t.idx()])));
+                }
+                for group in out.boxes[f..].chunks(CHUNK) {
+                    out.groups.push(union(&mut group.iter().copied()));
+                }
+                (f as u32, g as u32)
+            });
+            out.first.push(f);
+            out.first_group.push(g);
         }
         out
     }
 
-    /// The chunk boxes of list `i` of `len` blockers (empty for a short list).
+    /// List `i` (stored at `list`) with its chunk and group boxes if it is long.
     #[inline]
-    fn of(&self, i: usize, len: usize) -> &[Aabb] {
+    fn of<'s>(&'s self, i: usize, list: &'s [TriId]) -> Chunked<'s> {
         match self.first[i] {
-            u32::MAX => &[],
-            f => &self.boxes[f as usize..f as usize + len.div_ceil(CHUNK)],
+            u32::MAX => Chunked { list, chunks: &[], groups: &[] },
+            f => {
+                let (f, g) = (f as usize, self.first_group[i] as usize);
+                let n = list.len().div_ceil(CHUNK);
+                Chunked { list, chunks: &self.boxes[f..f + n], groups: &self.groups[g..g + n.div_ceil(CHUNK)] }
+            }
         }
     }
+}
+
+/// A blocker list with, if long, the boxes of its chunks and of its groups of chunks.
+#[derive(Clone, Copy)]
+struct Chunked<'a> {
+    list: &'a [TriId],
+    chunks: &'a [Aabb],
+    groups: &'a [Aabb],
+}
+
+impl Chunked<'_> {
+    const EMPTY: Chunked<'static> = Chunked { list: &[], chunks: &[], groups: &[] };
 }
 
 /// Modes (b)-(d) and `grid`: the P-LIE's blocker lists, regions and face grids.
@@ -117,25 +142,27 @@ impl<'a> LieVisibility<'a> {
         seg.clip(&self.tri_boxes[t.idx()]).is_some() && blocks(self.scene, ray, t, ctx)
     }
 
-    /// True if a triangle of `list` blocks the ray (tested in order, stopping at the first; with
-    /// `chunks`, only the chunks whose box the segment meets), and the number of triangle tests that
-    /// took.
+    /// True if a triangle of `l` blocks the ray (stopping at the first; in a long list, only inside
+    /// the groups and chunks whose box the segment meets), and the number of triangle tests that took.
     #[inline]
-    fn any_blocks(
-        &self,
-        seg: &Segment,
-        ray: &ShadowRay,
-        list: &[TriId],
-        chunks: &[Aabb],
-        ctx: &mut QueryCtx,
-    ) -> (bool, u64) {
+    fn any_blocks(&self, seg: &Segment, ray: &ShadowRay, l: Chunked, ctx: &mut QueryCtx) -> (bool, u64) {
         let before = ctx.stats.triangle_tests;
-        let hit = if chunks.is_empty() {
-            list.iter().any(|&t| self.test(seg, ray, t, ctx))
+        let meets = |b: &Aabb, ctx: &mut QueryCtx| {
+            ctx.stats.box_tests += 1;
+            seg.clip(b).is_some()
+        };
+        let hit = if l.chunks.is_empty() {
+            l.list.iter().any(|&t| self.test(seg, ray, t, ctx))
         } else {
-            list.chunks(CHUNK).zip(chunks).any(|(chunk, b)| {
-                ctx.stats.box_tests += 1;
-                seg.clip(b).is_some() && chunk.iter().any(|&t| self.test(seg, ray, t, ctx))
+            let per_group = CHUNK * CHUNK;
+            l.groups.iter().enumerate().any(|(gi, g)| {
+                meets(g, ctx) && {
+                    let tris = &l.list[gi * per_group..l.list.len().min((gi + 1) * per_group)];
+                    let boxes = &l.chunks[gi * CHUNK..l.chunks.len().min((gi + 1) * CHUNK)];
+                    tris.chunks(CHUNK)
+                        .zip(boxes)
+                        .any(|(chunk, b)| meets(b, ctx) && chunk.iter().any(|&t| self.test(seg, ray, t, ctx)))
+                }
             })
         };
         (hit, ctx.stats.triangle_tests - before)
@@ -181,18 +208,15 @@ impl Visibility for LieVisibility<'_> {
                     return ctx.stats.answered(Answer::NoRecord, true);
                 };
                 let f = ray.test.origin + ray.test.dir * t_exit;
-                let record = || {
-                    let list = self.plie.blockers_of(&self.plie.records[ri]);
-                    (list, self.record_boxes.of(ri, list.len()))
-                };
-                let (list, chunks) = match self.mode {
+                let record = || self.record_boxes.of(ri, self.plie.blockers_of(&self.plie.records[ri]));
+                let list = match self.mode {
                     Mode::Umbra | Mode::Penumbra => {
                         let x = FaceFrame::new(face, &self.octree.leaf_bounds(leaf)).units(f.as_dvec3());
                         if in_triangles(self.plie.umbra_of(ri), x) {
                             return ctx.stats.answered(Answer::Umbra, true);
                         }
                         if self.mode == Mode::Penumbra && !in_triangles(self.plie.penumbra_of(ri), x) {
-                            (&[][..], &[][..])
+                            Chunked::EMPTY
                         } else {
                             record()
                         }
@@ -202,17 +226,15 @@ impl Visibility for LieVisibility<'_> {
                         let c = grid::cell_of(face, &self.octree.leaf_bounds(leaf), grid.res, f);
                         match self.plie.cell(grid, c) {
                             Cell::Umbra => return ctx.stats.answered(Answer::Umbra, true),
-                            Cell::Blockers(list) => {
-                                (list, self.cell_boxes.of(grid.cells_start as usize + c, list.len()))
-                            }
+                            Cell::Blockers(list) => self.cell_boxes.of(grid.cells_start as usize + c, list),
                         }
                     }
                     _ => record(),
                 };
-                if list.is_empty() {
+                if list.list.is_empty() {
                     Answer::Lit
                 } else {
-                    let (hit, tests) = self.any_blocks(&seg, ray, list, chunks, ctx);
+                    let (hit, tests) = self.any_blocks(&seg, ray, list, ctx);
                     ctx.stats.blocker_tests += tests;
                     if hit {
                         return ctx.stats.answered(Answer::BlockersHit, true);
@@ -233,6 +255,57 @@ impl Visibility for LieVisibility<'_> {
             ctx.stats.answered(Answer::OwnLeaf, true)
         } else {
             ctx.stats.answered(through, false)
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::construct::build;
+    use crate::lie::PlieParams;
+    use crate::render::NoProgress;
+
+    /// Every triangle of a long list lies in its chunk's box and that in its group's box; shared
+    /// ranges share boxes; long lists are stored in Morton order, so chunks are tighter than in id
+    /// order.
+    #[test]
+    fn chunk_boxes_cover_their_lists() {
+        let scene = crate::scene::builtin::load("huis-a").unwrap();
+        let params = PlieParams { grids: true, ..PlieParams::thesis() };
+        let octree = Octree::build(&scene, params.octree());
+        let (plie, _) = build(&scene, &octree, params, &NoProgress);
+        let vis = LieVisibility::new(&scene, &octree, &plie, Mode::Grid);
+        let inside = |a: &Aabb, b: &Aabb| b.min.cmple(a.min).all() && a.max.cmple(b.max).all();
+        let (mut long, mut volume_sorted, mut volume_ids) = (0, 0.0f64, 0.0f64);
+        for (ri, r) in plie.records.iter().enumerate() {
+            let l = vis.record_boxes.of(ri, plie.blockers_of(r));
+            if l.list.len() < CHUNKED_MIN {
+                assert!(l.chunks.is_empty() && l.groups.is_empty());
+                continue;
+            }
+            long += 1;
+            for (k, chunk) in l.list.chunks(CHUNK).enumerate() {
+                assert!(chunk.iter().all(|t| inside(&vis.tri_boxes[t.idx()], &l.chunks[k])));
+                assert!(inside(&l.chunks[k], &l.groups[k / CHUNK]));
+                let vol = |b: Aabb| b.size().as_dvec3().element_product();
+                volume_sorted += vol(l.chunks[k]);
+                let mut ids = l.list.to_vec();
+                ids.sort_unstable();
+                let by_id = ids[k * CHUNK..(k * CHUNK + CHUNK).min(ids.len())].iter().map(|t| vis.tri_boxes[t.idx()]);
+                volume_ids += vol(by_id.reduce(Aabb::union).unwrap());
+            }
+        }
+        assert!(long > 10, "{long} long lists");
+        assert!(volume_sorted < volume_ids, "Morton chunks {volume_sorted} vs id chunks {volume_ids}");
+        // Cells sharing a list share its boxes.
+        let b = &vis.cell_boxes;
+        for (c, &(start, len)) in plie.cells.iter().enumerate() {
+            if b.first[c] == u32::MAX {
+                continue;
+            }
+            let other = plie.cells.iter().position(|&x| x == (start, len)).unwrap();
+            assert_eq!(b.first[c], b.first[other]);
         }
     }
 }
