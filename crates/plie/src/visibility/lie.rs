@@ -151,17 +151,23 @@ impl<'a> LieVisibility<'a> {
             ctx.stats.box_tests += 1;
             seg.clip(b).is_some()
         };
+        // The chunks of `tris` whose boxes (`boxes`) the segment meets.
+        let scan = |tris: &[TriId], boxes: &[Aabb], ctx: &mut QueryCtx| {
+            tris.chunks(CHUNK)
+                .zip(boxes)
+                .any(|(chunk, b)| meets(b, ctx) && chunk.iter().any(|&t| self.test(seg, ray, t, ctx)))
+        };
         let hit = if l.chunks.is_empty() {
             l.list.iter().any(|&t| self.test(seg, ray, t, ctx))
+        } else if l.groups.len() == 1 {
+            // One group: its box would only repeat the chunks' tests.
+            scan(l.list, l.chunks, ctx)
         } else {
             let per_group = CHUNK * CHUNK;
             l.groups.iter().enumerate().any(|(gi, g)| {
                 meets(g, ctx) && {
                     let tris = &l.list[gi * per_group..l.list.len().min((gi + 1) * per_group)];
-                    let boxes = &l.chunks[gi * CHUNK..l.chunks.len().min((gi + 1) * CHUNK)];
-                    tris.chunks(CHUNK)
-                        .zip(boxes)
-                        .any(|(chunk, b)| meets(b, ctx) && chunk.iter().any(|&t| self.test(seg, ray, t, ctx)))
+                    scan(tris, &l.chunks[gi * CHUNK..l.chunks.len().min((gi + 1) * CHUNK)], ctx)
                 }
             })
         };
