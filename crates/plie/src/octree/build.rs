@@ -108,30 +108,45 @@ impl Octree {
         for (p, split) in frontier.into_iter().zip(splits) {
             match split {
                 Some(children) => {
-                    let first = self.nodes.len() as u32;
-                    self.nodes[p.node as usize] = Node::inner(first);
-                    debug_assert_eq!(first as usize, 1 + 8 * self.parents.len(), "child blocks start at 1 + 8 m");
-                    self.parents.push(p.node);
+                    let first = self.push_children(p.node);
                     for (i, tris) in children.into_iter().enumerate() {
-                        let bounds = child_box(&p.bounds, i);
-                        self.nodes.push(Node::UNSET);
-                        self.node_bounds.push(bounds);
-                        next.push(Pending { node: first + i as u32, bounds, depth: p.depth + 1, tris });
+                        let node = first + i as u32;
+                        let bounds = self.node_bounds[node as usize];
+                        next.push(Pending { node, bounds, depth: p.depth + 1, tris });
                     }
                 }
-                None => {
-                    let id = LeafId(self.leaves.len() as u32);
-                    self.nodes[p.node as usize] = Node::leaf(id);
-                    let start = self.leaf_tris.len();
-                    self.leaf_tris.extend_from_slice(&p.tris);
-                    let end = self.leaf_tris.len();
-                    assert!(end <= u32::MAX as usize, "too many leaf triangle references for u32 ranges");
-                    self.leaves.push(Leaf { node: p.node, depth: p.depth, start: start as u32, end: end as u32 });
-                    self.depth = self.depth.max(p.depth);
-                }
+                None => self.push_leaf(p.node, p.depth, &p.tris),
             }
         }
         next
+    }
+}
+
+impl Octree {
+    /// Makes `node` an inner node with a new block of 8 undecided children (boxes from
+    /// [`child_box`]) at the end of the arrays; returns the first child's index.
+    pub(super) fn push_children(&mut self, node: u32) -> u32 {
+        let first = self.nodes.len() as u32;
+        self.nodes[node as usize] = Node::inner(first);
+        debug_assert_eq!(first as usize, 1 + 8 * self.parents.len(), "child blocks start at 1 + 8 m");
+        self.parents.push(node);
+        let bounds = self.node_bounds[node as usize];
+        for i in 0..8 {
+            self.nodes.push(Node::UNSET);
+            self.node_bounds.push(child_box(&bounds, i));
+        }
+        first
+    }
+
+    /// Makes `node` the next leaf, at `depth`, with the triangle list `tris`.
+    pub(super) fn push_leaf(&mut self, node: u32, depth: u32, tris: &[TriId]) {
+        let id = LeafId(self.leaves.len() as u32);
+        self.nodes[node as usize] = Node::leaf(id);
+        let start = self.leaf_tris.len() as u32;
+        self.leaf_tris.extend_from_slice(tris);
+        assert!(self.leaf_tris.len() <= u32::MAX as usize, "too many leaf triangle references for u32 ranges");
+        self.leaves.push(Leaf { node, depth, start, end: self.leaf_tris.len() as u32 });
+        self.depth = self.depth.max(depth);
     }
 }
 

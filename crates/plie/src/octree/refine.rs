@@ -14,7 +14,7 @@
 use rayon::prelude::*;
 
 use super::build::split_cell;
-use super::{child_box, Leaf, LeafId, Node, NodeId, Octree, MAX_DEPTH_LIMIT};
+use super::{LeafId, NodeId, Octree, MAX_DEPTH_LIMIT};
 use crate::error::{Error, Result};
 use crate::scene::Scene;
 
@@ -62,13 +62,8 @@ impl Octree {
         }
         for (&l, children) in split.iter().zip(parts) {
             let old = self.leaves[l.idx()];
-            let first = t.nodes.len() as u32;
-            t.nodes[old.node as usize] = Node::inner(first);
-            t.parents.push(old.node);
-            let bounds = self.node_bounds[old.node as usize];
+            let first = t.push_children(old.node);
             for (i, tris) in children.iter().enumerate() {
-                t.nodes.push(Node::UNSET);
-                t.node_bounds.push(child_box(&bounds, i));
                 t.push_leaf(first + i as u32, old.depth + 1, tris);
                 origin.push(None);
             }
@@ -95,17 +90,6 @@ impl Octree {
             return Err(Error::InvalidParameter("refinement split list is not in leaf order".into()));
         }
         Ok(self.split_leaves(scene, &leaves).0)
-    }
-
-    /// Appends a leaf at `node` with its triangle list.
-    fn push_leaf(&mut self, node: u32, depth: u32, tris: &[crate::scene::TriId]) {
-        let id = LeafId(self.leaves.len() as u32);
-        self.nodes[node as usize] = Node::leaf(id);
-        let start = self.leaf_tris.len() as u32;
-        self.leaf_tris.extend_from_slice(tris);
-        assert!(self.leaf_tris.len() <= u32::MAX as usize, "too many leaf triangle references for u32 ranges");
-        self.leaves.push(Leaf { node, depth, start, end: self.leaf_tris.len() as u32 });
-        self.depth = self.depth.max(depth);
     }
 }
 
