@@ -54,6 +54,12 @@ pub fn tolerance(scene: &Scene, octree: &Octree) -> f32 {
     scene.scale().max(octree.root_bounds().size().max_element()) * TOLERANCE_REL
 }
 
+/// The largest absolute coordinate of `octree`'s root cube: the scale of the `f32` rounding the
+/// regions and propagation allow for.
+pub(crate) fn abs_scale(octree: &Octree) -> f32 {
+    octree.root_bounds().min.abs().max(octree.root_bounds().max.abs()).max_element()
+}
+
 /// Named counters and stage times of one construction.
 #[derive(Clone, Debug, Default, PartialEq, Serialize)]
 pub struct BuildStats {
@@ -321,54 +327,37 @@ fn run_round(
 ) -> Round {
     let tol = tolerance(scene, octree);
     let lights = scene.lights.len();
-    let abs_scale = octree.root_bounds().min.abs().max(octree.root_bounds().max.abs()).max_element();
+    let abs_scale = abs_scale(octree);
     let tols = Tolerances::new(tol, abs_scale);
     let propagate = params.propagation && params.regions;
     let order = propagation::task_order(scene, octree, propagate);
     let mut states = FaceStates::new(scene, octree, tol);
     let mut propagator = Propagator::new(scene, octree, tols);
-    let mut reused: Vec<Option<TaskRecords>> = Vec::new();
+    let mut tasks: Vec<TaskRecords> = (0..octree.leaf_count() * lights).map(|_| TaskRecords::default()).collect();
     if let Some(Prior { round, origin }) = prior {
         // Kept leaves start with their final states and records; their propagated faces stay logged.
-        let mut new_of = vec![None; round.tasks.len() / lights.max(1)];
+        let Round { tasks: mut old_tasks, states: old_states, propagator_log, .. } = round;
+        let mut new_of = vec![None; old_tasks.len() / lights.max(1)];
         for (new, old) in origin.iter().enumerate() {
-            if let Some(old) = old {
-                new_of[old.idx()] = Some(LeafId(new as u32));
+            let Some(old) = *old else { continue };
+            let new = LeafId(new as u32);
+            new_of[old.idx()] = Some(new);
+            for i in 0..lights {
+                tasks[new.idx() * lights + i] = std::mem::take(&mut old_tasks[old.idx() * lights + i]);
                 for face in Dir::ALL {
-                    for i in 0..lights as u32 {
-                        let light = LightId(i);
-                        states.set(LeafId(new as u32), face, light, round.states.get(*old, face, light));
-                    }
+                    let light = LightId(i as u32);
+                    states.set(new, face, light, old_states.get(old, face, light));
                 }
             }
         }
-        propagator.log = round
-            .propagator_log
-            .iter()
-            .filter_map(|p| new_of[p.leaf.idx()].map(|leaf| Propagated { leaf, ..*p }))
-            .collect();
-        let mut old_tasks: Vec<Option<TaskRecords>> = round.tasks.into_iter().map(Some).collect();
-        reused = origin
-            .iter()
-            .flat_map(|o| (0..lights).map(move |i| o.map(|old| old.idx() * lights + i)))
-            .map(|k| k.and_then(|k| old_tasks[k].take()))
-            .collect();
+        propagator.log =
+            propagator_log.iter().filter_map(|p| new_of[p.leaf.idx()].map(|leaf| Propagated { leaf, ..*p })).collect();
     }
     let initial = states.clone();
     // Set at the commit that deletes a face: workers skip it (a face deleted later is computed anyway,
     // and its result discarded at its own commit).
     let deleted: Vec<AtomicBool> = (0..states.len()).map(|_| AtomicBool::new(false)).collect();
-    let mut commits = Commits {
-        states,
-        propagator,
-        tasks: (0..octree.leaf_count() * lights)
-            .map(|k| reused.get_mut(k).and_then(Option::take).unwrap_or_default())
-            .collect(),
-        lights,
-        propagate,
-        seconds: 0.0,
-        wasted: 0,
-    };
+    let mut commits = Commits { states, propagator, tasks, lights, propagate, seconds: 0.0, wasted: 0 };
     let scratches: Vec<Mutex<GatherScratch>> = (0..rayon::current_num_threads().max(1))
         .map(|_| Mutex::new(GatherScratch::new(scene.triangles.len())))
         .collect();

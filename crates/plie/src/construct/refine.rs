@@ -254,7 +254,7 @@ mod tests {
         let top = octree.leaf_bounds(leaf);
         assert!((top.max.y - 1.0).abs() < 1e-2 && top.min.x.abs() < 1e-2 && (top.max.x - 1.0).abs() < 1e-2);
         let tol = tolerance(&scene, &octree);
-        let abs = octree.root_bounds().min.abs().max(octree.root_bounds().max.abs()).max_element();
+        let abs = crate::construct::abs_scale(&octree);
         let tols = Tolerances::new(tol, abs);
         let mut scratch = GatherScratch::new(scene.triangles.len());
         let params = PlieParams { refine: *p, ..PlieParams::thesis() };
