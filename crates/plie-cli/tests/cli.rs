@@ -1,30 +1,12 @@
 //! The `plie` binary end to end: listing scenes, rendering, and bad input. Every bad input must give a
 //! one-line error naming the problem and a non-zero exit, never a panic.
 
+mod support;
+
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::process::Command;
 
-fn plie(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_plie")).args(args).output().expect("run plie")
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
-}
-
-/// Runs `plie args`, expects failure with a one-line error containing `needle`.
-fn fails_with(args: &[&str], needle: &str) {
-    let o = plie(args);
-    let err = stderr(&o);
-    assert!(!o.status.success(), "{args:?} should fail; stderr: {err}");
-    assert!(!err.contains("panicked"), "{args:?} panicked: {err}");
-    let lines: Vec<&str> = err.lines().filter(|l| !l.trim().is_empty()).collect();
-    assert_eq!(lines.len(), 1, "{args:?}: expected a one-line error, got: {err}");
-    assert!(
-        lines[0].to_lowercase().contains(&needle.to_lowercase()),
-        "{args:?}: error should mention '{needle}': {err}"
-    );
-}
+use support::{fails_with, plie, stderr};
 
 fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
     let p = dir.join(name);

@@ -2,8 +2,9 @@
 //! loads again with the `gltf` crate with the expected meshes and colours, the summary agrees with
 //! `plie build`, and bad input gives a one-line error and a non-zero exit, never a panic.
 
+mod support;
+
 use std::path::Path;
-use std::process::{Command, Output};
 
 use glam::Vec3;
 use plie::geometry::Aabb;
@@ -12,28 +13,7 @@ use plie::io::image::srgb_encode;
 use plie::lie::PlieParams;
 use plie::octree::Octree;
 use plie::Camera;
-
-fn plie(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_plie")).args(args).output().expect("run plie")
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
-}
-
-/// Runs `plie args`, expects failure with a one-line error containing `needle`.
-fn fails_with(args: &[&str], needle: &str) {
-    let o = plie(args);
-    let err = stderr(&o);
-    assert!(!o.status.success(), "{args:?} should fail; stderr: {err}");
-    assert!(!err.contains("panicked"), "{args:?} panicked: {err}");
-    let lines: Vec<&str> = err.lines().filter(|l| !l.trim().is_empty()).collect();
-    assert_eq!(lines.len(), 1, "{args:?}: expected a one-line error, got: {err}");
-    assert!(
-        lines[0].to_lowercase().contains(&needle.to_lowercase()),
-        "{args:?}: error should mention '{needle}': {err}"
-    );
-}
+use support::{fails_with, plie, stderr};
 
 /// `X,Y,Z` of a point.
 fn arg(p: Vec3) -> String {
