@@ -74,7 +74,7 @@ impl Plan {
             (true, false) => builtin::NAMES.iter().map(|s| s.to_string()).collect(),
         };
         let (sizes, shadow_rays) = if a.quick { (vec![32], vec![4]) } else { (vec![126, 254], vec![4, 9]) };
-        let modes: Vec<Mode> = Mode::ALL.into_iter().filter(|m| *m != Mode::Brute).collect();
+        let modes: Vec<Mode> = Mode::EXACT.into_iter().filter(|m| *m != Mode::Brute).collect();
         let refined_modes = modes.iter().copied().filter(|m| m.needs_plie()).collect();
         Ok(Plan { scenes, sizes, shadow_rays, runs, modes, refined_modes })
     }

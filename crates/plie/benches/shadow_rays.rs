@@ -43,7 +43,7 @@ fn bench(c: &mut Criterion) {
         let rays = rays(&scene, &octree);
         let mut group = c.benchmark_group(format!("shadow_rays/{name}"));
         group.throughput(Throughput::Elements(rays.len() as u64));
-        for mode in Mode::ALL.into_iter().filter(|m| *m != Mode::Brute) {
+        for mode in Mode::EXACT.into_iter().filter(|m| *m != Mode::Brute) {
             let vis = for_mode(mode, &scene, &bvh, &octree, Some(&plie)).expect("mode");
             let mut ctx = QueryCtx::new(scene.triangle_count());
             group.bench_with_input(BenchmarkId::from_parameter(mode), &rays, |b, rays| {

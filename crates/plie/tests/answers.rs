@@ -74,7 +74,7 @@ fn every_shadow_ray_of_a_render_takes_exactly_one_path() {
 #[test]
 fn modes_without_a_p_lie_count_no_paths() {
     for (scene, built) in scenes() {
-        for mode in Mode::ALL.into_iter().filter(|m| !m.needs_plie()) {
+        for mode in Mode::EXACT.into_iter().filter(|m| !m.needs_plie()) {
             let s = render_stats(&scene, &built, mode);
             assert!(s.shadow_rays > 0 && s.triangle_tests > 0, "{} {mode}", scene.name);
             assert_eq!(s.answers.total(), 0, "{} {mode}: {s:?}", scene.name);

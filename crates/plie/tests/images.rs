@@ -16,7 +16,7 @@ fn images(scene: &Scene, threads: usize, settings: &RenderSettings) -> Vec<(Mode
     pool.install(|| {
         let built = Built::new(scene, PlieParams::default());
         let camera = scene.camera_or_default();
-        Mode::ALL
+        Mode::EXACT
             .into_iter()
             .map(|mode| {
                 let vis = built.vis(scene, mode);

@@ -16,7 +16,7 @@ use super::hit_buffer::{Hit, HitBuffer};
 use super::sampler::{n_rooks, Rng};
 use super::Progress;
 use crate::scene::{LightId, Scene};
-use crate::visibility::{QueryCtx, QueryStats, ShadowRay, Visibility};
+use crate::visibility::{LightRays, QueryCtx, QueryStats, Visibility};
 
 /// Per-thread scratch space for shading.
 pub struct ShadeScratch {
@@ -24,21 +24,32 @@ pub struct ShadeScratch {
     pub ctx: QueryCtx,
     samples: Vec<Vec2>,
     perm: Vec<u32>,
+    /// The light samples of the current (point, light) that face it, and their geometry terms.
+    targets: Vec<Vec3>,
+    weights: Vec<f32>,
+    occluded: Vec<bool>,
 }
 
 impl ShadeScratch {
     /// Scratch space for `scene` with `n` samples per light.
     pub fn new(scene: &Scene, n: u32) -> ShadeScratch {
+        let n = n as usize;
         ShadeScratch {
             ctx: QueryCtx::new(scene.triangles.len()),
-            samples: vec![Vec2::ZERO; n as usize],
-            perm: Vec::with_capacity(n as usize),
+            samples: vec![Vec2::ZERO; n],
+            perm: Vec::with_capacity(n),
+            targets: Vec::with_capacity(n),
+            weights: Vec::with_capacity(n),
+            occluded: vec![false; n],
         }
     }
 }
 
 /// Radiance toward the eye at one hit: emission (front side only) plus direct lighting from every
 /// light. `stream` identifies the eye ray (pixel and sub-ray index) for the random streams.
+///
+/// The samples of a light that face the point (both cosines positive) are asked of the visibility
+/// together ([`Visibility::occluded_light`]); the unoccluded ones are summed in sample order.
 pub fn shade_hit(
     scene: &Scene,
     vis: &dyn Visibility,
@@ -58,9 +69,10 @@ pub fn shade_hit(
     for (i, light) in scene.lights.iter().enumerate() {
         let mut rng = Rng::stream(seed, stream.0, stream.1, i as u64);
         n_rooks(&mut rng, &mut s.samples, &mut s.perm);
-        let mut sum = 0.0f32;
-        for k in 0..n_samples {
-            let y = light.sample(s.samples[k]);
+        s.targets.clear();
+        s.weights.clear();
+        for &u in &s.samples {
+            let y = light.sample(u);
             let d = y - x;
             let dist2 = d.length_squared();
             if dist2.is_nan() || dist2 <= 0.0 {
@@ -72,13 +84,25 @@ pub fn shade_hit(
             if cos_x <= 0.0 || cos_y <= 0.0 {
                 continue;
             }
-            let ray = ShadowRay::new(x, y, LightId(i as u32), hit.tri, hit.leaf);
-            s.ctx.stats.shadow_rays += 1;
-            if vis.occluded(&ray, &mut s.ctx) {
+            s.targets.push(y);
+            s.weights.push(cos_x * cos_y / dist2);
+        }
+        let m = s.targets.len();
+        if m == 0 {
+            continue;
+        }
+        let rays =
+            LightRays { origin: x, origin_tri: hit.tri, leaf: hit.leaf, light: LightId(i as u32), targets: &s.targets };
+        let occluded = &mut s.occluded[..m];
+        vis.occluded_light(&rays, occluded, &mut s.ctx);
+        s.ctx.stats.shadow_rays += m as u64;
+        let mut sum = 0.0f32;
+        for (w, &o) in s.weights.iter().zip(occluded.iter()) {
+            if o {
                 s.ctx.stats.occluded += 1;
-                continue;
+            } else {
+                sum += w;
             }
-            sum += cos_x * cos_y / dist2;
         }
         l += light.radiance * f_r * (light.area / n_samples as f32 * sum);
     }

@@ -22,7 +22,7 @@ pub use embree::{Embree, EmbreeVisibility};
 pub use lie::LieVisibility;
 pub use mode::Mode;
 pub use octree::OctreeVisibility;
-pub use query::{blocks, QueryCtx, QueryStats, ShadowRay};
+pub use query::{blocks, LightRays, QueryCtx, QueryStats, ShadowRay};
 
 /// Test fixture shared by the modes' unit tests: a floor, a wall half above it, and a light above
 /// both. Returns the scene and the floor triangle.
@@ -43,11 +43,36 @@ pub(crate) fn wall_scene() -> (crate::Scene, crate::TriId) {
     (b.build().expect("valid scene"), floor)
 }
 
-/// A visibility method: answers shadow-ray queries exactly.
+/// A visibility method: answers shadow-ray queries exactly (but for the reference modes that say
+/// otherwise: [`Mode::None`], and native Embree).
 pub trait Visibility: Sync {
     /// True if some triangle other than the ray's own (its origin triangle and the target light's
     /// triangles) intersects the open segment. `ctx` is the calling thread's scratch space and counters.
     fn occluded(&self, ray: &ShadowRay, ctx: &mut QueryCtx) -> bool;
+
+    /// Answers all the shadow rays of one light from one point at once: `out[k]` is set to
+    /// [`Visibility::occluded`] of [`LightRays::ray`]`(k)`, and must equal it exactly.
+    /// `out.len() == rays.targets.len()`. The default asks each ray in turn; modes override it to share
+    /// work between rays that share their origin.
+    fn occluded_light(&self, rays: &LightRays, out: &mut [bool], ctx: &mut QueryCtx) {
+        debug_assert_eq!(out.len(), rays.targets.len());
+        for (k, o) in out.iter_mut().enumerate() {
+            *o = self.occluded(&rays.ray(k), ctx);
+        }
+    }
+}
+
+/// `--visibility none`: every shadow ray unoccluded. Not exact; it measures shading alone.
+pub struct NoVisibility;
+
+impl Visibility for NoVisibility {
+    fn occluded(&self, _ray: &ShadowRay, _ctx: &mut QueryCtx) -> bool {
+        false
+    }
+
+    fn occluded_light(&self, _rays: &LightRays, out: &mut [bool], _ctx: &mut QueryCtx) {
+        out.fill(false);
+    }
 }
 
 /// The visibility method for `mode`, over the structures already built. Fails if `mode` needs a
@@ -75,5 +100,6 @@ pub fn for_mode<'a>(
         }
         #[cfg(feature = "embree")]
         Mode::Embree => Box::new(EmbreeVisibility::new(scene)?),
+        Mode::None => Box::new(NoVisibility),
     })
 }

@@ -25,17 +25,32 @@ pub enum Mode {
     /// Intel Embree 3 proposing candidates to the shared predicate (cargo feature `embree`).
     #[cfg(feature = "embree")]
     Embree,
+    /// No shadow test at all: every shadow ray is unoccluded. Not exact: it exists to measure what
+    /// shading costs without any visibility (the floor every other mode adds to).
+    None,
 }
 
 impl Mode {
-    /// Every mode, for tests that compare them all.
+    /// Every exact mode: each answers every shadow ray as `brute` does. The exactness suites compare
+    /// them all.
     #[cfg(not(feature = "embree"))]
-    pub const ALL: [Mode; 7] =
+    pub const EXACT: [Mode; 7] =
         [Mode::Brute, Mode::Octree, Mode::Bvh, Mode::Lie, Mode::Umbra, Mode::Penumbra, Mode::Grid];
-    /// Every mode, for tests that compare them all.
+    /// Every exact mode: each answers every shadow ray as `brute` does. The exactness suites compare
+    /// them all.
     #[cfg(feature = "embree")]
-    pub const ALL: [Mode; 8] =
+    pub const EXACT: [Mode; 8] =
         [Mode::Brute, Mode::Octree, Mode::Bvh, Mode::Lie, Mode::Umbra, Mode::Penumbra, Mode::Grid, Mode::Embree];
+
+    /// Every mode a user can choose: the exact ones and the reference `none`.
+    pub fn all() -> impl Iterator<Item = Mode> {
+        Mode::EXACT.into_iter().chain([Mode::None])
+    }
+
+    /// True if the mode answers every shadow ray as `brute` does.
+    pub fn is_exact(self) -> bool {
+        self != Mode::None
+    }
 
     /// The name used on the command line.
     pub fn name(self) -> &'static str {
@@ -49,6 +64,7 @@ impl Mode {
             Mode::Grid => "grid",
             #[cfg(feature = "embree")]
             Mode::Embree => "embree",
+            Mode::None => "none",
         }
     }
 
@@ -72,8 +88,8 @@ impl fmt::Display for Mode {
 impl FromStr for Mode {
     type Err = String;
     fn from_str(s: &str) -> Result<Mode, String> {
-        Mode::ALL.into_iter().find(|m| m.name() == s).ok_or_else(|| {
-            let names: Vec<_> = Mode::ALL.iter().map(|m| m.name()).collect();
+        Mode::all().find(|m| m.name() == s).ok_or_else(|| {
+            let names: Vec<_> = Mode::all().map(|m| m.name()).collect();
             format!("unknown visibility mode '{s}' (choose from {})", names.join(", "))
         })
     }

@@ -44,6 +44,31 @@ impl ShadowRay {
     }
 }
 
+/// The shadow rays of one light from one shaded point `x`: segments from `x` to each of `targets`.
+/// They share their origin, so a mode can answer them together
+/// ([`super::Visibility::occluded_light`]).
+#[derive(Clone, Copy, Debug)]
+pub struct LightRays<'a> {
+    /// The shaded point `x`.
+    pub origin: Vec3,
+    /// The triangle `x` lies on (as [`ShadowRay::origin_tri`]).
+    pub origin_tri: TriId,
+    /// The octree leaf containing `x`, when known.
+    pub leaf: Option<LeafId>,
+    /// The light sampled.
+    pub light: LightId,
+    /// The light samples `y_k`.
+    pub targets: &'a [Vec3],
+}
+
+impl LightRays<'_> {
+    /// The `k`-th shadow ray.
+    #[inline]
+    pub fn ray(&self, k: usize) -> ShadowRay {
+        ShadowRay::new(self.origin, self.targets[k], self.light, self.origin_tri, self.leaf)
+    }
+}
+
 /// Counters of one thread's queries, summed over threads at the end.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
 pub struct QueryStats {
