@@ -82,7 +82,7 @@ pub fn write_all(out: &Path, thesis_dir: &Path, plan: &Plan, r: &Results) -> Res
     Ok(())
 }
 
-fn write_text(path: &Path, text: &str) -> Result<()> {
+pub fn write_text(path: &Path, text: &str) -> Result<()> {
     let io = |e| plie::Error::Io { path: path.to_path_buf(), source: e };
     plie::io::write_atomic(path, |w| w.write_all(text.as_bytes()).map_err(io))
         .with_context(|| format!("cannot write {}", path.display()))

@@ -113,10 +113,12 @@ pub fn run(a: &Args) -> Result<()> {
             "plie_load_seconds": load_plie_seconds,
             "hit_buffer_seconds": out.hit_buffer_seconds,
             "shading_seconds": out.shading_seconds,
+            "shading_cpu_seconds": out.shading_cpu_seconds,
             "shadow_rays": s.shadow_rays,
             "occluded": s.occluded,
             "triangle_tests": s.triangle_tests,
             "triangle_tests_per_shadow_ray": per_ray,
+            "lane_tests": s.lane_tests,
             "box_tests": s.box_tests,
             "box_tests_per_shadow_ray": s.box_tests as f64 / s.shadow_rays.max(1) as f64,
             "blocker_tests": s.blocker_tests,
@@ -124,6 +126,7 @@ pub fn run(a: &Args) -> Result<()> {
             "own_leaf_tests": s.own_leaf_tests,
             "own_leaf_tests_per_shadow_ray": s.own_leaf_tests as f64 / s.shadow_rays.max(1) as f64,
             "answers": s.answers,
+            "light_queries": s.lights,
             "shadow_rays_per_second": rays_per_second,
             "output": a.output.display().to_string(),
         });
@@ -160,6 +163,10 @@ pub fn run(a: &Args) -> Result<()> {
             rays_per_second / 1e6
         );
         eprintln!("triangle tests   {} ({per_ray:.2} per shadow ray)", s.triangle_tests);
+        if s.lane_tests > 0 {
+            let lanes = s.lane_tests as f64 / s.shadow_rays.max(1) as f64;
+            eprintln!("fan lane tests   {} ({lanes:.2} per shadow ray)", s.lane_tests);
+        }
         print_answers(&s);
     }
     if !a.quiet && !a.json && !a.stats {
@@ -184,5 +191,13 @@ fn print_answers(s: &QueryStats) {
     for a in Answer::ALL {
         let n = s.answers.get(a);
         eprintln!("  {:<14} {n:>12} {:>6.1}%", a.name(), 100.0 * per_ray(n));
+    }
+    let l = &s.lights;
+    if l.queries > 0 {
+        let share = |n: u64| 100.0 * n as f64 / l.queries as f64;
+        eprintln!("(point, light)   {:>12} {:>7}", "pairs", "share");
+        for (name, n) in [("whole umbra", l.whole_umbra), ("whole lit", l.whole_lit), ("per sample", l.per_sample)] {
+            eprintln!("  {name:<14} {n:>12} {:>6.1}%", share(n));
+        }
     }
 }

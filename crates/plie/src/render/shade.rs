@@ -24,7 +24,11 @@ pub struct ShadeScratch {
     pub ctx: QueryCtx,
     samples: Vec<Vec2>,
     perm: Vec<u32>,
-    /// The light samples of the current (point, light) that face it, and their geometry terms.
+    /// The current light's sample points, and per sample its geometry term (`NaN`: it does not
+    /// face the point).
+    points: Vec<Vec3>,
+    terms: Vec<f32>,
+    /// The samples that face the point, their geometry terms, and their visibility.
     targets: Vec<Vec3>,
     weights: Vec<f32>,
     occluded: Vec<bool>,
@@ -38,11 +42,33 @@ impl ShadeScratch {
             ctx: QueryCtx::new(scene.triangles.len()),
             samples: vec![Vec2::ZERO; n],
             perm: Vec::with_capacity(n),
+            points: Vec::with_capacity(n),
+            terms: Vec::with_capacity(n),
             targets: Vec::with_capacity(n),
             weights: Vec::with_capacity(n),
             occluded: vec![false; n],
         }
     }
+}
+
+/// The geometry term `cos_x cos_y / |x - y|^2` of each sample point `y` of a light with normal
+/// `nl`, seen from `x` with normal `n`, into `terms`; `NaN` where either cosine is not positive
+/// (or `y = x`): no shadow ray is shot there. Written lane by lane so that it vectorises; `sqrt` and
+/// division are correctly rounded in every lane, so the values are those of the scalar formula.
+fn geometry_terms(x: Vec3, n: Vec3, nl: Vec3, points: &[Vec3], terms: &mut Vec<f32>) {
+    terms.clear();
+    terms.extend(points.iter().map(|&y| {
+        let d = y - x;
+        let dist2 = d.length_squared();
+        let inv_len = dist2.sqrt().recip();
+        let cos_x = n.dot(d) * inv_len;
+        let cos_y = -nl.dot(d) * inv_len;
+        if dist2 > 0.0 && cos_x > 0.0 && cos_y > 0.0 {
+            cos_x * cos_y / dist2
+        } else {
+            f32::NAN
+        }
+    }));
 }
 
 /// Radiance toward the eye at one hit: emission (front side only) plus direct lighting from every
@@ -69,23 +95,16 @@ pub fn shade_hit(
     for (i, light) in scene.lights.iter().enumerate() {
         let mut rng = Rng::stream(seed, stream.0, stream.1, i as u64);
         n_rooks(&mut rng, &mut s.samples, &mut s.perm);
+        s.points.clear();
+        light.sample_into(&s.samples, &mut s.points);
+        geometry_terms(x, hit.normal, light.normal, &s.points, &mut s.terms);
         s.targets.clear();
         s.weights.clear();
-        for &u in &s.samples {
-            let y = light.sample(u);
-            let d = y - x;
-            let dist2 = d.length_squared();
-            if dist2.is_nan() || dist2 <= 0.0 {
-                continue;
+        for (&y, &w) in s.points.iter().zip(&s.terms) {
+            if !w.is_nan() {
+                s.targets.push(y);
+                s.weights.push(w);
             }
-            let inv_len = dist2.sqrt().recip();
-            let cos_x = hit.normal.dot(d) * inv_len;
-            let cos_y = -light.normal.dot(d) * inv_len;
-            if cos_x <= 0.0 || cos_y <= 0.0 {
-                continue;
-            }
-            s.targets.push(y);
-            s.weights.push(cos_x * cos_y / dist2);
         }
         let m = s.targets.len();
         if m == 0 {

@@ -79,8 +79,21 @@ impl Light {
         Ok(Light { vertices, normal, area, radiance, triangles, fan_cdf, parallelogram })
     }
 
+    /// [`Light::sample`] of every `u` of `us`, appended to `out` (the same values, computed with the
+    /// same operations: a parallelogram's edge vectors are only computed once).
+    pub fn sample_into(&self, us: &[Vec2], out: &mut Vec<Vec3>) {
+        if self.parallelogram {
+            let v = &self.vertices;
+            let (o, e1, e3) = (v[0], v[1] - v[0], v[3] - v[0]);
+            out.extend(us.iter().map(|u| o + e1 * u.x + e3 * u.y));
+        } else {
+            out.extend(us.iter().map(|&u| self.sample(u)));
+        }
+    }
+
     /// Maps `u` in the unit square to a point on the light, uniformly by area: a stratified set of `u`
     /// (N-rooks) stays stratified over the light.
+    #[inline]
     pub fn sample(&self, u: Vec2) -> Vec3 {
         let v = &self.vertices;
         if self.parallelogram {

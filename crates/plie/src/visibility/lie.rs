@@ -15,8 +15,10 @@
 //! Each ray is counted on the [`Answer`] path that decided it, and its triangle tests are split into
 //! blocker tests and own-leaf tests (`plie render --stats`).
 
+use super::fan::Fan;
 use super::leaf_voxels::LeafVoxels;
-use super::{blocks, Answer, Mode, OctreeVisibility, QueryCtx, ShadowRay, Visibility};
+use super::query::SEGMENT_EPS;
+use super::{blocks, Answer, LightRays, Mode, OctreeVisibility, QueryCtx, ShadowRay, Visibility};
 use crate::construct::grid;
 use crate::construct::regions::{in_triangles, FaceFrame};
 use crate::geometry::{Aabb, Segment};
@@ -115,6 +117,13 @@ pub struct LieVisibility<'a> {
     record_boxes: ListBoxes,
     /// Chunk boxes of the face-grid cells' lists.
     cell_boxes: ListBoxes,
+    /// The construction tolerance (how far triangle boxes are grown).
+    pad: f32,
+    /// Per leaf, its own triangles in Morton order (`(start, len)` into `own_tris`), with chunk
+    /// boxes: the per-light query culls them by chunk against its pyramid.
+    own: Vec<(u32, u32)>,
+    own_tris: Vec<TriId>,
+    own_boxes: ListBoxes,
 }
 
 impl<'a> LieVisibility<'a> {
@@ -132,7 +141,29 @@ impl<'a> LieVisibility<'a> {
         } else {
             ListBoxes::default()
         };
-        LieVisibility { scene, octree, plie, tri_boxes, voxels, mode, record_boxes, cell_boxes }
+        let mut own = Vec::with_capacity(octree.leaf_count());
+        let mut own_tris = Vec::new();
+        for leaf in octree.leaves() {
+            let start = own_tris.len();
+            own_tris.extend_from_slice(octree.leaf_triangles(leaf));
+            crate::geometry::morton::sort_spatially(scene, &mut own_tris[start..]);
+            own.push((start as u32, (own_tris.len() - start) as u32));
+        }
+        let own_boxes = ListBoxes::new(own.iter().copied(), &own_tris, &tri_boxes);
+        LieVisibility {
+            scene,
+            octree,
+            plie,
+            tri_boxes,
+            voxels,
+            mode,
+            record_boxes,
+            cell_boxes,
+            pad,
+            own,
+            own_tris,
+            own_boxes,
+        }
     }
 
     /// The box cull, then the shared predicate.
@@ -179,9 +210,13 @@ impl<'a> LieVisibility<'a> {
 /// it does, or `None` if it stays inside for its whole open range.
 #[inline]
 pub fn exit_face(octree: &Octree, leaf: LeafId, ray: &ShadowRay) -> Option<(Dir, f32)> {
-    let b = octree.leaf_bounds(leaf);
-    let (o, d) = (ray.test.origin, ray.test.dir);
-    let mut best = (ray.test.t_max, None);
+    exit_face_of(&octree.leaf_bounds(leaf), ray.test.origin, ray.test.dir, ray.test.t_max)
+}
+
+/// [`exit_face`] for the box `b` and the segment `o + t d`, `t < t_max`.
+#[inline]
+fn exit_face_of(b: &Aabb, o: glam::Vec3, d: glam::Vec3, t_max: f32) -> Option<(Dir, f32)> {
+    let mut best = (t_max, None);
     for k in 0..3 {
         let (t, positive) = if d[k] > 0.0 {
             ((b.max[k] - o[k]) / d[k], true)
@@ -261,6 +296,256 @@ impl Visibility for LieVisibility<'_> {
             ctx.stats.answered(Answer::OwnLeaf, true)
         } else {
             ctx.stats.answered(through, false)
+        }
+    }
+
+    /// All samples of one light from one point (issue 21): each ray finds its exit face, record and
+    /// (in `grid`) its cell exactly as [`Visibility::occluded`] does, so no record and umbra answer
+    /// rays without a test. The remaining rays are tested as a fan ([`Fan`]): each distinct blocker
+    /// list once against the rays that need it, then the leaf's own triangles against every ray
+    /// still open, every candidate first culled by the pyramid from the point to the light. Testing
+    /// a ray against more triangles than its own list can only find true blockers, so every answer is
+    /// the per-ray answer.
+    #[allow(clippy::needless_range_loop)] // `k` indexes the rays' targets, paths, lists and answers alike
+    fn occluded_light(&self, rays: &LightRays, out: &mut [bool], ctx: &mut QueryCtx) {
+        let leaf = rays.leaf.or_else(|| self.octree.locate(rays.origin));
+        let Some(leaf) = leaf.filter(|_| rays.targets.len() >= FAN_MIN) else {
+            for (k, o) in out.iter_mut().enumerate() {
+                *o = self.occluded(&rays.ray(k), ctx);
+            }
+            return;
+        };
+        let n = rays.targets.len();
+        let mut scratch = std::mem::take(&mut ctx.light);
+        let sc = &mut scratch;
+        sc.fan.set(rays);
+        sc.path.clear();
+        sc.path.resize(n, path::LIT);
+        sc.list.clear();
+        sc.list.resize(n, u32::MAX);
+        sc.lists.clear();
+        out.fill(false);
+        let bounds = self.octree.leaf_bounds(leaf);
+        let x = rays.origin;
+        // Per face: the record (`None`: no record), looked up once.
+        let mut records: [Option<Option<usize>>; 6] = [None; 6];
+        for k in 0..n {
+            let d = rays.targets[k] - x;
+            let Some((face, t_exit)) = exit_face_of(&bounds, x, d, 1.0 - SEGMENT_EPS) else {
+                sc.path[k] = path::INSIDE;
+                continue;
+            };
+            let record = *records[face.index()].get_or_insert_with(|| self.plie.record_id(leaf, face, rays.light));
+            let Some(ri) = record else {
+                out[k] = ctx.stats.answered(Answer::NoRecord, true);
+                sc.path[k] = path::DONE;
+                continue;
+            };
+            let f = x + d * t_exit;
+            let key = match self.mode {
+                Mode::Umbra | Mode::Penumbra => {
+                    let p = FaceFrame::new(face, &bounds).units(f.as_dvec3());
+                    if in_triangles(self.plie.umbra_of(ri), p) {
+                        out[k] = ctx.stats.answered(Answer::Umbra, true);
+                        sc.path[k] = path::DONE;
+                        continue;
+                    }
+                    if self.mode == Mode::Penumbra && !in_triangles(self.plie.penumbra_of(ri), p) {
+                        None
+                    } else {
+                        Some(ri as u32)
+                    }
+                }
+                Mode::Grid if self.plie.grids[ri].res > 0 => {
+                    let grid = &self.plie.grids[ri];
+                    let c = grid::cell_of(face, &bounds, grid.res, f);
+                    let ci = grid.cells_start as usize + c;
+                    match self.plie.cells[ci] {
+                        crate::lie::UMBRA_CELL => {
+                            out[k] = ctx.stats.answered(Answer::Umbra, true);
+                            sc.path[k] = path::DONE;
+                            continue;
+                        }
+                        (_, 0) => None,
+                        _ => Some(ci as u32 | CELL_KEY),
+                    }
+                }
+                _ => Some(ri as u32).filter(|_| self.plie.records[ri].blockers_len > 0),
+            };
+            if let Some(key) = key {
+                sc.path[k] = path::LIST;
+                let i = match sc.lists.iter().position(|&l| l == key) {
+                    Some(i) => i,
+                    None => {
+                        sc.lists.push(key);
+                        sc.lists.len() - 1
+                    }
+                };
+                sc.list[k] = i as u32;
+            }
+        }
+        let open = sc.path.iter().filter(|&&p| p != path::DONE).count();
+        ctx.stats.lights.queries += 1;
+        if open == 0 {
+            ctx.stats.lights.whole_umbra += 1;
+        } else {
+            let lanes_before = ctx.stats.lane_tests;
+            let margin = self.pad * 10.0;
+            sc.fan.pyramid.set(x, &self.scene.lights[rays.light.idx()], margin);
+            // Short lists: their triangles, each once, against every ray that has a short list (a
+            // ray tested against another ray's blockers too can only find true blockers). Long lists
+            // (with chunk boxes) are walked ray by ray as `occluded` does: a thin segment culls their
+            // chunks far better than the pyramid does.
+            let before = ctx.stats.triangle_tests;
+            let long = |key: u32| !self.list_of(key).chunks.is_empty();
+            for k in 0..n {
+                if sc.list[k] != u32::MAX && long(sc.lists[sc.list[k] as usize]) {
+                    let ray = rays.ray(k);
+                    let seg = Segment::new(ray.test.origin, ray.test.dir, ray.test.t_min, ray.test.t_max);
+                    out[k] = self.any_blocks(&seg, &ray, self.list_of(sc.lists[sc.list[k] as usize]), ctx).0;
+                }
+            }
+            let (lists, list_of) = (&sc.lists, &sc.list);
+            sc.fan.select(|k| list_of[k] != u32::MAX && !long(lists[list_of[k] as usize]));
+            ctx.begin_query();
+            for &key in &sc.lists {
+                if !long(key) {
+                    self.fan_list(rays, self.list_of(key), true, &mut sc.fan, out, ctx);
+                }
+            }
+            ctx.stats.blocker_tests += ctx.stats.triangle_tests - before;
+            // The leaf's own triangles against every ray still open.
+            for k in 0..n {
+                if sc.path[k] == path::LIST && out[k] {
+                    sc.path[k] = path::LIST_HIT;
+                }
+            }
+            let paths = &sc.path;
+            sc.fan.select(|k| paths[k] != path::DONE && !out[k]);
+            let before = ctx.stats.triangle_tests;
+            let (start, len) = self.own[leaf.idx()];
+            let own = self.own_boxes.of(leaf.idx(), &self.own_tris[start as usize..(start + len) as usize]);
+            self.fan_list(rays, own, false, &mut sc.fan, out, ctx);
+            ctx.stats.own_leaf_tests += ctx.stats.triangle_tests - before;
+            for k in 0..n {
+                let a = match (sc.path[k], out[k]) {
+                    (path::DONE, _) => continue,
+                    (path::LIST_HIT, _) => Answer::BlockersHit,
+                    (_, true) => Answer::OwnLeaf,
+                    (path::LIT, false) => Answer::Lit,
+                    (path::LIST, false) => Answer::BlockersMiss,
+                    _ => Answer::InsideLeaf,
+                };
+                ctx.stats.answered(a, out[k]);
+            }
+            if ctx.stats.lane_tests == lanes_before {
+                ctx.stats.lights.whole_lit += 1;
+            } else {
+                ctx.stats.lights.per_sample += 1;
+            }
+        }
+        ctx.light = scratch;
+    }
+}
+
+/// How a ray of a per-light query is answered if no candidate triangle hits it, and then whether
+/// one did.
+mod path {
+    /// Already answered (occluded: no record, or umbra).
+    pub const DONE: u8 = 0;
+    /// No blocker to test: lit.
+    pub const LIT: u8 = 1;
+    /// Its blocker list is to be tested.
+    pub const LIST: u8 = 2;
+    /// It never leaves the leaf.
+    pub const INSIDE: u8 = 3;
+    /// Its blocker list hit it.
+    pub const LIST_HIT: u8 = 4;
+}
+
+/// Fewer samples than this are asked ray by ray: with so few, sharing work does not pay (measured at
+/// 4 samples per light, `plie bench --soft-shadows`).
+const FAN_MIN: usize = 8;
+
+/// A blocker list key of a per-light query: a record's index, or a face-grid cell's index with the
+/// top bit set.
+const CELL_KEY: u32 = 1 << 31;
+
+impl LieVisibility<'_> {
+    /// The blocker list of `key` with its chunk boxes.
+    #[inline]
+    fn list_of(&self, key: u32) -> Chunked<'_> {
+        if key & CELL_KEY != 0 {
+            let c = (key & !CELL_KEY) as usize;
+            let (start, len) = self.plie.cells[c];
+            self.cell_boxes.of(c, &self.plie.cell_blockers[start as usize..(start + len) as usize])
+        } else {
+            let ri = key as usize;
+            self.record_boxes.of(ri, self.plie.blockers_of(&self.plie.records[ri]))
+        }
+    }
+
+    /// Tests the triangles `tris` that the pyramid does not cull against the fan's open active rays,
+    /// marking those hit in `out`; with `once`, only those not met before in the query.
+    #[inline]
+    fn fan_tris(
+        &self,
+        rays: &LightRays,
+        tris: &[TriId],
+        once: bool,
+        fan: &mut Fan,
+        out: &mut [bool],
+        ctx: &mut QueryCtx,
+    ) {
+        for &t in tris {
+            if fan.live() == 0 {
+                return;
+            }
+            if t == rays.origin_tri
+                || self.scene.tri_light[t.idx()] == Some(rays.light)
+                || (once && !ctx.first_visit(t))
+            {
+                continue;
+            }
+            ctx.stats.box_tests += 1;
+            if fan.pyramid.culls(&self.scene.triangles[t.idx()]) {
+                continue;
+            }
+            fan.test(self.scene, rays, t, out, ctx);
+        }
+    }
+
+    /// [`Self::fan_tris`] over a blocker list, skipping the groups and chunks whose boxes the
+    /// pyramid culls.
+    fn fan_list(
+        &self,
+        rays: &LightRays,
+        list: Chunked,
+        once: bool,
+        fan: &mut Fan,
+        out: &mut [bool],
+        ctx: &mut QueryCtx,
+    ) {
+        if list.chunks.is_empty() {
+            return self.fan_tris(rays, list.list, once, fan, out, ctx);
+        }
+        let per_group = CHUNK * CHUNK;
+        for (gi, group) in list.list.chunks(per_group).enumerate() {
+            if fan.live() == 0 {
+                return;
+            }
+            if list.groups.len() > 1 {
+                ctx.stats.box_tests += 1;
+                if fan.pyramid.culls_box(&list.groups[gi]) {
+                    continue;
+                }
+            }
+            for (ci, chunk) in group.chunks(CHUNK).enumerate() {
+                ctx.stats.box_tests += 1;
+                if !fan.pyramid.culls_box(&list.chunks[gi * CHUNK + ci]) {
+                    self.fan_tris(rays, chunk, once, fan, out, ctx);
+                }
+            }
         }
     }
 }

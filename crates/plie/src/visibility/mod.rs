@@ -8,6 +8,7 @@ pub mod brute;
 pub mod bvh;
 #[cfg(feature = "embree")]
 pub mod embree;
+pub mod fan;
 pub mod leaf_voxels;
 pub mod lie;
 pub mod mode;
@@ -22,7 +23,7 @@ pub use embree::{Embree, EmbreeVisibility};
 pub use lie::LieVisibility;
 pub use mode::Mode;
 pub use octree::OctreeVisibility;
-pub use query::{blocks, LightRays, QueryCtx, QueryStats, ShadowRay};
+pub use query::{blocks, LightAnswers, LightRays, QueryCtx, QueryStats, ShadowRay};
 
 /// Test fixture shared by the modes' unit tests: a floor, a wall half above it, and a light above
 /// both. Returns the scene and the floor triangle.

@@ -78,14 +78,44 @@ pub struct QueryStats {
     pub occluded: u64,
     /// Watertight triangle tests run.
     pub triangle_tests: u64,
-    /// Candidate bounding-box tests run before triangle tests (P-LIE modes).
+    /// Candidate bounding-box tests run before triangle tests (P-LIE modes; in the per-light queries,
+    /// the pyramid culls of triangles and of their chunks).
     pub box_tests: u64,
+    /// (triangle, ray) pairs decided by the fan's fast test (per-light queries of the P-LIE modes):
+    /// sure misses, and the rays it sent on to the watertight test.
+    pub lane_tests: u64,
     /// Of `triangle_tests`, those of a record's (or grid cell's) blockers (P-LIE modes).
     pub blocker_tests: u64,
     /// Of `triangle_tests`, those of the triangles of the ray's own leaf (P-LIE modes).
     pub own_leaf_tests: u64,
     /// How the shadow rays were answered (P-LIE modes; zero in the others).
     pub answers: Answers,
+    /// How the (point, light) queries of [`super::Visibility::occluded_light`] were answered (P-LIE
+    /// modes; zero in the others).
+    pub lights: LightAnswers,
+}
+
+/// How the P-LIE modes answered the (point, light) pairs: all samples at once, or sample by sample.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
+pub struct LightAnswers {
+    /// Pairs asked.
+    pub queries: u64,
+    /// Pairs whose every ray was occluded without a triangle test (no record or umbra).
+    pub whole_umbra: u64,
+    /// Pairs whose every ray was answered without a triangle test, some of them lit (no blocker in
+    /// their cell and no triangle of the leaf in the pyramid to the light).
+    pub whole_lit: u64,
+    /// Pairs that tested candidate triangles against their rays.
+    pub per_sample: u64,
+}
+
+impl std::ops::AddAssign for LightAnswers {
+    fn add_assign(&mut self, o: LightAnswers) {
+        self.queries += o.queries;
+        self.whole_umbra += o.whole_umbra;
+        self.whole_lit += o.whole_lit;
+        self.per_sample += o.per_sample;
+    }
 }
 
 impl QueryStats {
@@ -105,9 +135,11 @@ impl std::ops::AddAssign for QueryStats {
         self.occluded += o.occluded;
         self.triangle_tests += o.triangle_tests;
         self.box_tests += o.box_tests;
+        self.lane_tests += o.lane_tests;
         self.blocker_tests += o.blocker_tests;
         self.own_leaf_tests += o.own_leaf_tests;
         self.answers += o.answers;
+        self.lights += o.lights;
     }
 }
 
@@ -117,6 +149,8 @@ impl std::ops::AddAssign for QueryStats {
 pub struct QueryCtx {
     /// Counters.
     pub stats: QueryStats,
+    /// Scratch of the per-light queries.
+    pub(crate) light: super::fan::LightScratch,
     stamps: Vec<u32>,
     stamp: u32,
 }
@@ -124,7 +158,7 @@ pub struct QueryCtx {
 impl QueryCtx {
     /// A context for a scene with `triangles` triangles.
     pub fn new(triangles: usize) -> QueryCtx {
-        QueryCtx { stats: QueryStats::default(), stamps: vec![0; triangles], stamp: 0 }
+        QueryCtx { stats: QueryStats::default(), light: Default::default(), stamps: vec![0; triangles], stamp: 0 }
     }
 
     /// Starts a new query: every triangle counts as unvisited again.

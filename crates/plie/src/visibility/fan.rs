@@ -1,0 +1,409 @@
+//! A fan of shadow rays: the `N` segments from one shaded point `x` to the samples `y_k` of one light,
+//! tested against a candidate triangle all at once (issue 21; SPEC §5 asks each ray alone).
+//!
+//! The rays share their origin, so a triangle `(a, b, c)` (relative to `x`) gives three edge planes
+//! through `x` with normals `b × c`, `c × a`, `a × b`. A ray with direction `d` passes inside the
+//! triangle's cone when the three edge functions `n_i · d` have one sign; when one is clearly positive
+//! and another clearly negative, it passes outside, and the watertight test (which evaluates the same
+//! three functions, up to one common factor, in its sheared frame) must miss. "Clearly" means beyond a
+//! margin of `EDGE_MARGIN |p| |q| |d|` for the edge `(p, q)`, which bounds the rounding of both
+//! computations with a wide safety factor (see [`EDGE_MARGIN`]). Those misses are decided `N` lanes wide
+//! without the watertight test; every other (triangle, ray) pair — inside, near an edge, or not
+//! finite — gets the exact [`blocks`](super::blocks) predicate. So each answer is the watertight
+//! test's, bit for bit, and the fast path only skips work.
+//!
+//! A second cull rejects a triangle for all rays at once: the pyramid from `x` over the light polygon
+//! ([`Pyramid`]), grown by a margin, contains every segment; a triangle whose three vertices lie
+//! beyond one of its planes meets none of them.
+
+use glam::Vec3;
+
+use super::query::SEGMENT_EPS;
+use super::{LightRays, QueryCtx, ShadowRay};
+use crate::geometry::{Aabb, Triangle};
+use crate::scene::{Light, Scene, TriId};
+
+/// Relative margin of the edge functions. The watertight test's sheared edge function of an edge
+/// `(p, q)` differs from the real `det(p, q, d) / d_kz` by at most about `32 ε |p| |q|` (the shear has
+/// factors of magnitude at most 1), and ours, a cross product and a dot product, from
+/// `det(p, q, d)` by at most about `10 ε |p| |q| |d|`; since `|d_kz| <= |d|`, a computed value beyond
+/// `42 ε |p| |q| |d|` has the sign of the real one, and so has the watertight test's. We take six times
+/// that.
+pub const EDGE_MARGIN: f32 = 256.0 * f32::EPSILON;
+
+/// The pyramid conv(`x` ∪ light polygon), as planes with inward unit normals through `x` (one per
+/// light edge) and the light's own plane, each grown outward by `margin`.
+#[derive(Clone, Debug, Default)]
+pub struct Pyramid {
+    /// Inward unit normals of the side planes (through the apex).
+    sides: Vec<Vec3>,
+    /// Unit normal of the light plane pointing toward the apex, and the plane's offset.
+    cap: (Vec3, f32),
+    apex: Vec3,
+    margin: f32,
+}
+
+impl Pyramid {
+    /// The pyramid from `x` over `light`'s sample domain, grown by `margin` (a length). Returns false
+    /// (and leaves an empty pyramid, which culls nothing) if `x` lies too close to the light's plane
+    /// for the side planes to be well defined.
+    pub fn set(&mut self, x: Vec3, light: &Light, margin: f32) -> bool {
+        self.sides.clear();
+        self.apex = x;
+        self.margin = margin;
+        let n = light.normal;
+        let v = &light.vertices;
+        let h = n.dot(x - v[0]);
+        self.cap = (n, n.dot(v[0]));
+        if h.is_nan() || h <= 4.0 * margin {
+            return false;
+        }
+        // The sample domain's hull is the polygon (plus, for a parallelogram, its fourth corner
+        // recomputed, within rounding of the vertex): the polygon's edges, grown by the margin.
+        for i in 0..v.len() {
+            let (p, q) = (v[i] - x, v[(i + 1) % v.len()] - x);
+            // The plane through the apex and the edge (p, q), its normal turned toward the centre.
+            let s = p.cross(q);
+            let len = s.length();
+            if len.is_nan() || len <= 0.0 || len.is_infinite() {
+                self.sides.clear();
+                return false;
+            }
+            let mut s = s / len;
+            if s.dot(light.center() - x) < 0.0 {
+                s = -s;
+            }
+            self.sides.push(s);
+        }
+        true
+    }
+
+    /// True if no segment from the apex to a point of the light (within the margin) can meet
+    /// `tri`: all its vertices lie beyond one plane.
+    #[inline]
+    pub fn culls(&self, tri: &Triangle) -> bool {
+        let x = self.apex;
+        let m = self.margin;
+        let (a, b, c) = (tri.v[0] - x, tri.v[1] - x, tri.v[2] - x);
+        for s in &self.sides {
+            if s.dot(a) < -m && s.dot(b) < -m && s.dot(c) < -m {
+                return true;
+            }
+        }
+        if self.sides.is_empty() {
+            return false;
+        }
+        let (n, off) = self.cap;
+        n.dot(tri.v[0]) - off < -m && n.dot(tri.v[1]) - off < -m && n.dot(tri.v[2]) - off < -m
+    }
+
+    /// True if no segment of the pyramid can meet anything in the box `b`.
+    #[inline]
+    pub fn culls_box(&self, b: &Aabb) -> bool {
+        if self.sides.is_empty() {
+            return false;
+        }
+        let x = self.apex;
+        let m = self.margin;
+        // The box corner farthest along the normal.
+        let far = |s: Vec3| Vec3::select(s.cmpge(Vec3::ZERO), b.max, b.min);
+        for s in &self.sides {
+            if s.dot(far(*s) - x) < -m {
+                return true;
+            }
+        }
+        let (n, off) = self.cap;
+        n.dot(far(n)) - off < -m
+    }
+}
+
+/// Lanes of the fast test.
+const LANES: usize = 8;
+
+/// Per-thread scratch of a fan: the directions `d_k = y_k - x`, their lengths, the lazily built
+/// exact ray tests, and the *active* rays (those the current candidates are tested against) copied
+/// into lanes.
+#[derive(Clone, Debug, Default)]
+pub struct Fan {
+    origin: Vec3,
+    dirs: Vec<Vec3>,
+    lens: Vec<f32>,
+    /// The exact tests, built on first use (`None` until then).
+    rays: Vec<Option<ShadowRay>>,
+    /// Active rays: their indices, and their directions and lengths in lanes (padded with zeros to a
+    /// multiple of [`LANES`]).
+    idx: Vec<u32>,
+    ax: Vec<f32>,
+    ay: Vec<f32>,
+    az: Vec<f32>,
+    al: Vec<f32>,
+    /// Per active lane: the watertight test's `1 / d[kz]`, and its axis `kz`.
+    asz: Vec<f32>,
+    akz: Vec<u32>,
+    /// Per ray: the watertight test's axis `kz` (the largest component of `d`) and `1 / d[kz]`.
+    kzs: Vec<u8>,
+    szs: Vec<f32>,
+    /// Bit `j` of word `j / 64`: active lane `j` is still open (not found occluded).
+    open: Vec<u64>,
+    /// Bit per active lane: the fast test could not prove a miss for the current triangle.
+    maybe: Vec<u64>,
+    /// Active rays still open.
+    live: usize,
+    /// The pyramid of the current light.
+    pub pyramid: Pyramid,
+}
+
+impl Fan {
+    /// Starts the fan of `rays` (directions computed exactly as [`ShadowRay::new`] does).
+    pub fn set(&mut self, rays: &LightRays) {
+        let x = rays.origin;
+        self.origin = x;
+        self.dirs.clear();
+        self.lens.clear();
+        self.kzs.clear();
+        self.szs.clear();
+        for y in rays.targets {
+            let d = *y - x;
+            self.dirs.push(d);
+            self.lens.push(d.length());
+            // As `RayTest::new` chooses it.
+            let a = d.abs();
+            let kz = if a.x >= a.y && a.x >= a.z {
+                0
+            } else if a.y >= a.z {
+                1
+            } else {
+                2
+            };
+            self.kzs.push(kz as u8);
+            self.szs.push(1.0 / d[kz]);
+        }
+        self.rays.clear();
+        self.rays.resize(rays.targets.len(), None);
+        self.live = 0;
+    }
+
+    /// Makes the rays `k` with `want(k)` the active ones.
+    pub fn select(&mut self, want: impl Fn(usize) -> bool) {
+        for v in [&mut self.ax, &mut self.ay, &mut self.az, &mut self.al, &mut self.asz] {
+            v.clear();
+        }
+        self.idx.clear();
+        self.akz.clear();
+        for k in 0..self.dirs.len() {
+            if want(k) {
+                let d = self.dirs[k];
+                self.idx.push(k as u32);
+                self.ax.push(d.x);
+                self.ay.push(d.y);
+                self.az.push(d.z);
+                self.al.push(self.lens[k]);
+                self.asz.push(self.szs[k]);
+                self.akz.push(u32::from(self.kzs[k]));
+            }
+        }
+        let m = self.idx.len();
+        let padded = m.div_ceil(LANES) * LANES;
+        for v in [&mut self.ax, &mut self.ay, &mut self.az, &mut self.al, &mut self.asz] {
+            v.resize(padded, 0.0);
+        }
+        self.akz.resize(padded, 0);
+        let words = m.div_ceil(64);
+        self.open.clear();
+        self.open.resize(words, u64::MAX);
+        if m % 64 != 0 {
+            self.open[words - 1] = (1u64 << (m % 64)) - 1;
+        }
+        self.maybe.clear();
+        self.maybe.resize(words, 0);
+        self.live = m;
+    }
+
+    /// Active rays not yet found occluded.
+    #[inline]
+    pub fn live(&self) -> usize {
+        self.live
+    }
+
+    /// Tests triangle `t` against the open active rays: each ray `k` it blocks gets `out[k]` set and
+    /// is closed. Counts a lane test per open ray, and a triangle test per watertight test. The caller has excluded the rays' own
+    /// triangles (the origin's and the light's).
+    #[inline]
+    pub fn test(&mut self, scene: &Scene, rays: &LightRays, t: TriId, out: &mut [bool], ctx: &mut QueryCtx) {
+        let tri = &scene.triangles[t.idx()];
+        let x = self.origin;
+        let (a, b, c) = (tri.v[0] - x, tri.v[1] - x, tri.v[2] - x);
+        // Edge normals scaled by the inverse of their margins: a lane is a sure miss where one scaled
+        // edge function exceeds `|d|` and another is below `-|d|`. (The L1 norm bounds the
+        // Euclidean one, so the margins only grow; the scaling's own rounding is far inside them.)
+        let l1 = |v: Vec3| v.abs().element_sum();
+        let (la, lb, lc) = (l1(a), l1(b), l1(c));
+        let s = [
+            b.cross(c) * (EDGE_MARGIN * lb * lc).recip(),
+            c.cross(a) * (EDGE_MARGIN * lc * la).recip(),
+            a.cross(b) * (EDGE_MARGIN * la * lb).recip(),
+        ];
+        ctx.stats.lane_tests += self.live as u64;
+        // The watertight test's hit parameter is a weighted mean of the vertices' `p[kz] / d[kz]`
+        // (computed as it computes them); lanes where all of them lie outside the segment's range
+        // (beyond a margin for the mean's rounding) miss. Per axis, the least and greatest vertex
+        // coordinate.
+        let span = [0, 1, 2].map(|k| (a[k].min(b[k]).min(c[k]), a[k].max(b[k]).max(c[k])));
+        if s.iter().all(|v| v.is_finite()) {
+            let lanes = Lanes { x: &self.ax, y: &self.ay, z: &self.az, len: &self.al, sz: &self.asz, kz: &self.akz };
+            misses(&s, &span, &lanes, &mut self.maybe);
+        } else {
+            self.maybe.fill(u64::MAX);
+        }
+        for w in 0..self.open.len() {
+            let mut bits = self.maybe[w] & self.open[w];
+            while bits != 0 {
+                let j = w * 64 + bits.trailing_zeros() as usize;
+                bits &= bits - 1;
+                let k = self.idx[j] as usize;
+                let ray = *self.rays[k].get_or_insert_with(|| rays.ray(k));
+                ctx.stats.triangle_tests += 1;
+                if ray.test.hit(tri).is_some() {
+                    self.open[w] &= !(1u64 << (j % 64));
+                    self.live -= 1;
+                    out[k] = true;
+                }
+            }
+        }
+    }
+}
+
+/// The active rays in lanes (see [`Fan`]).
+struct Lanes<'a> {
+    x: &'a [f32],
+    y: &'a [f32],
+    z: &'a [f32],
+    len: &'a [f32],
+    sz: &'a [f32],
+    kz: &'a [u32],
+}
+
+/// Relative margin of the hit parameter's rounding: the watertight test's weighted mean of three
+/// products is within a few `ε` of the largest one's magnitude.
+const T_MARGIN: f32 = 1e-5;
+
+/// Sets bit `j` of `maybe` unless lane `j` is a sure miss of the triangle with scaled edge normals
+/// `s` (see [`Fan::test`]), or its hit parameter cannot fall in the segment's range (`span`: per
+/// axis, the least and greatest vertex coordinate, taken along the lane's `kz`).
+#[inline]
+fn misses(s: &[Vec3; 3], span: &[(f32, f32); 3], lanes: &Lanes, maybe: &mut [u64]) {
+    #[cfg(target_arch = "x86_64")]
+    if std::arch::is_x86_feature_detected!("avx2") {
+        // SAFETY: AVX2 is available (checked above); the lane arrays are padded to whole blocks.
+        unsafe { misses_avx(s, span, lanes, maybe) };
+        return;
+    }
+    misses_scalar(s, span, lanes, maybe);
+}
+
+/// [`misses`], lane by lane.
+fn misses_scalar(s: &[Vec3; 3], span: &[(f32, f32); 3], lanes: &Lanes, maybe: &mut [u64]) {
+    maybe.fill(0);
+    for j in 0..lanes.x.len().min(maybe.len() * 64) {
+        let d = Vec3::new(lanes.x[j], lanes.y[j], lanes.z[j]);
+        let l = lanes.len[j];
+        let e = [s[0].dot(d), s[1].dot(d), s[2].dot(d)];
+        let pos = e.iter().any(|&e| e > l);
+        let neg = e.iter().any(|&e| e < -l);
+        let outside = {
+            let (lo, hi) = span[lanes.kz[j] as usize];
+            let (z1, z2) = (lo * lanes.sz[j], hi * lanes.sz[j]);
+            let (zlo, zhi) = (z1.min(z2), z1.max(z2));
+            let m = T_MARGIN * zlo.abs().max(zhi.abs());
+            zlo > 1.0 - SEGMENT_EPS + m || zhi < SEGMENT_EPS - m
+        };
+        if !(outside || pos && neg) {
+            maybe[j / 64] |= 1 << (j % 64);
+        }
+    }
+}
+
+/// [`misses`], eight lanes at a time.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx,avx2")]
+unsafe fn misses_avx(s: &[Vec3; 3], span: &[(f32, f32); 3], lanes: &Lanes, maybe: &mut [u64]) {
+    use std::arch::x86_64::*;
+    let n = lanes
+        .x
+        .len()
+        .min(lanes.y.len())
+        .min(lanes.z.len())
+        .min(lanes.len.len())
+        .min(lanes.sz.len())
+        .min(lanes.kz.len())
+        / LANES
+        * LANES;
+    let sp = |v: f32| _mm256_set1_ps(v);
+    let (s0x, s0y, s0z) = (sp(s[0].x), sp(s[0].y), sp(s[0].z));
+    let (s1x, s1y, s1z) = (sp(s[1].x), sp(s[1].y), sp(s[1].z));
+    let (s2x, s2y, s2z) = (sp(s[2].x), sp(s[2].y), sp(s[2].z));
+    let sign = sp(-0.0);
+    let (lo, hi) = (span.map(|s| sp(s.0)), span.map(|s| sp(s.1)));
+    let (one, two) = (_mm256_set1_epi32(1), _mm256_set1_epi32(2));
+    let (t_min, t_max, t_margin) = (sp(SEGMENT_EPS), sp(1.0 - SEGMENT_EPS), sp(T_MARGIN));
+    maybe.fill(0);
+    let mut j = 0;
+    while j < n && j / 64 < maybe.len() {
+        // SAFETY: j + LANES <= n <= every array's length.
+        let (x, y, z, l) = unsafe {
+            (
+                _mm256_loadu_ps(lanes.x.as_ptr().add(j)),
+                _mm256_loadu_ps(lanes.y.as_ptr().add(j)),
+                _mm256_loadu_ps(lanes.z.as_ptr().add(j)),
+                _mm256_loadu_ps(lanes.len.as_ptr().add(j)),
+            )
+        };
+        let nl = _mm256_xor_ps(l, sign);
+        let dot =
+            |sx, sy, sz| _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(sx, x), _mm256_mul_ps(sy, y)), _mm256_mul_ps(sz, z));
+        let (e0, e1, e2) = (dot(s0x, s0y, s0z), dot(s1x, s1y, s1z), dot(s2x, s2y, s2z));
+        let pos = _mm256_or_ps(
+            _mm256_or_ps(_mm256_cmp_ps::<_CMP_GT_OQ>(e0, l), _mm256_cmp_ps::<_CMP_GT_OQ>(e1, l)),
+            _mm256_cmp_ps::<_CMP_GT_OQ>(e2, l),
+        );
+        let neg = _mm256_or_ps(
+            _mm256_or_ps(_mm256_cmp_ps::<_CMP_LT_OQ>(e0, nl), _mm256_cmp_ps::<_CMP_LT_OQ>(e1, nl)),
+            _mm256_cmp_ps::<_CMP_LT_OQ>(e2, nl),
+        );
+        let mut miss = _mm256_and_ps(pos, neg);
+        {
+            // SAFETY: as above.
+            let (sz, kz) = unsafe {
+                (_mm256_loadu_ps(lanes.sz.as_ptr().add(j)), _mm256_loadu_si256(lanes.kz.as_ptr().add(j).cast()))
+            };
+            // The span along each lane's own axis.
+            let is1 = _mm256_castsi256_ps(_mm256_cmpeq_epi32(kz, one));
+            let is2 = _mm256_castsi256_ps(_mm256_cmpeq_epi32(kz, two));
+            let pick = |v: [__m256; 3]| _mm256_blendv_ps(_mm256_blendv_ps(v[0], v[1], is1), v[2], is2);
+            let (lo, hi) = (pick(lo), pick(hi));
+            let (z1, z2) = (_mm256_mul_ps(lo, sz), _mm256_mul_ps(hi, sz));
+            let (zlo, zhi) = (_mm256_min_ps(z1, z2), _mm256_max_ps(z1, z2));
+            let abs = |v| _mm256_andnot_ps(sign, v);
+            let m = _mm256_mul_ps(t_margin, _mm256_max_ps(abs(zlo), abs(zhi)));
+            let far = _mm256_cmp_ps::<_CMP_GT_OQ>(zlo, _mm256_add_ps(t_max, m));
+            let near = _mm256_cmp_ps::<_CMP_LT_OQ>(zhi, _mm256_sub_ps(t_min, m));
+            miss = _mm256_or_ps(miss, _mm256_or_ps(far, near));
+        }
+        let miss = _mm256_movemask_ps(miss) as u64;
+        maybe[j / 64] |= (!miss & 0xff) << (j % 64);
+        j += LANES;
+    }
+}
+
+/// Per-thread scratch of the per-light queries ([`super::Visibility::occluded_light`]).
+#[derive(Clone, Debug, Default)]
+pub struct LightScratch {
+    /// The fan of the current (point, light).
+    pub fan: Fan,
+    /// Per ray: how it would be answered if no candidate hits it (an index for the mode's own use).
+    pub path: Vec<u8>,
+    /// Per ray: the index of its blocker list in `lists` (`u32::MAX`: none).
+    pub list: Vec<u32>,
+    /// The distinct blocker lists of the current (point, light): the mode's own keys.
+    pub lists: Vec<u32>,
+}

@@ -1,0 +1,160 @@
+//! The per-light query (`Visibility::occluded_light`, issue 21): all samples of one light from one
+//! point answered at once must equal the per-ray query sample by sample, and both must equal brute
+//! force, in every exact mode, on every built-in scene and on the real scenes in ../shared/scenes/.
+//! Points lie on triangles, on leaf faces, edges and corners, and anywhere; sample sets are random in
+//! size (1 to 80) and position; the point's leaf is given or left for the mode to find.
+
+mod support;
+
+use glam::{Vec2, Vec3};
+use plie::lie::PlieParams;
+use plie::visibility::{LightRays, Mode, QueryCtx};
+use plie::{LightId, Scene, TriId};
+use proptest::prelude::*;
+use support::{start_point, Built, TestRng};
+
+/// One (point, light) query.
+struct Query {
+    x: Vec3,
+    tri: TriId,
+    leaf: Option<plie::octree::LeafId>,
+    light: LightId,
+    targets: Vec<Vec3>,
+}
+
+impl Query {
+    fn rays(&self) -> LightRays<'_> {
+        LightRays { origin: self.x, origin_tri: self.tri, leaf: self.leaf, light: self.light, targets: &self.targets }
+    }
+}
+
+/// `n` queries: a point in front of a light, and 1 to 80 samples on it.
+fn queries(scene: &Scene, built: &Built, n: usize, seed: u64) -> Vec<Query> {
+    let mut rng = TestRng(seed);
+    let mut out = Vec::with_capacity(n);
+    while out.len() < n {
+        let li = rng.below(scene.lights.len());
+        let light = &scene.lights[li];
+        let (x, tri) = start_point(scene, &built.octree, &mut rng);
+        if (x - light.vertices[0]).dot(light.normal) <= 0.0 {
+            continue;
+        }
+        let count = if rng.below(3) == 0 { 64 } else { 1 + rng.below(80) };
+        let targets = (0..count).map(|_| light.sample(Vec2::new(rng.f32(), rng.f32()))).collect();
+        let leaf = if rng.below(4) == 0 { None } else { built.octree.locate(x) };
+        out.push(Query { x, tri, leaf, light: LightId(li as u32), targets });
+    }
+    out
+}
+
+/// Checks every exact mode's per-light answers against its per-ray answers and against brute force.
+fn check(scene: &Scene, built: &Built, qs: &[Query]) {
+    let brute = built.vis(scene, Mode::Brute);
+    let mut ctx = QueryCtx::new(scene.triangles.len());
+    let reference: Vec<Vec<bool>> =
+        qs.iter().map(|q| (0..q.targets.len()).map(|k| brute.occluded(&q.rays().ray(k), &mut ctx)).collect()).collect();
+    let blocked: usize = reference.iter().flatten().filter(|&&b| b).count();
+    let total: usize = reference.iter().map(Vec::len).sum();
+    assert!(blocked > 0 && blocked < total, "{}: the queries must include both answers", scene.name);
+    for mode in Mode::EXACT.into_iter().filter(|&m| m != Mode::Brute) {
+        let vis = built.vis(scene, mode);
+        let mut out = Vec::new();
+        for (qi, q) in qs.iter().enumerate() {
+            let rays = q.rays();
+            out.clear();
+            out.resize(q.targets.len(), false);
+            vis.occluded_light(&rays, &mut out, &mut ctx);
+            for k in 0..q.targets.len() {
+                let per_ray = vis.occluded(&rays.ray(k), &mut ctx);
+                assert_eq!(
+                    out[k], per_ray,
+                    "{} {mode}: query {qi} sample {k}: per-light {} per-ray {per_ray}",
+                    scene.name, out[k]
+                );
+                assert_eq!(
+                    out[k],
+                    reference[qi][k],
+                    "{} {mode}: query {qi} sample {k} ({:?}): {} but brute force says {}",
+                    scene.name,
+                    rays.ray(k),
+                    out[k],
+                    reference[qi][k]
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn per_light_answers_equal_per_ray_and_brute_force_on_builtin_scenes() {
+    for scene in support::builtins() {
+        let built = Built::new(&scene, PlieParams::thesis());
+        check(&scene, &built, &queries(&scene, &built, 400, 21));
+    }
+}
+
+#[test]
+fn per_light_answers_equal_per_ray_and_brute_force_on_shared_scenes() {
+    for scene in support::load_shared() {
+        let built = Built::new(&scene, PlieParams::thesis());
+        // Brute force over 100k triangles is slow: fewer queries on the large scenes.
+        let n = if scene.triangles.len() > 10_000 { 40 } else { 300 };
+        check(&scene, &built, &queries(&scene, &built, n, 22));
+    }
+}
+
+/// The refined P-LIE (split leaves) answers per light as per ray too.
+#[test]
+fn per_light_answers_on_a_refined_p_lie() {
+    let scene = plie::scene::builtin::load("huis-a").unwrap();
+    let refine = plie::construct::refine::RefineParams {
+        umbra_full: true,
+        umbra_free: true,
+        ..plie::construct::refine::RefineParams::none()
+    };
+    let params = PlieParams { refine, ..PlieParams::thesis() };
+    let built = Built::refined(&scene, params);
+    check(&scene, &built, &queries(&scene, &built, 300, 23));
+}
+
+fn cornell() -> &'static (Scene, Built) {
+    static S: std::sync::OnceLock<(Scene, Built)> = std::sync::OnceLock::new();
+    S.get_or_init(|| {
+        let scene = plie::scene::builtin::load("cornell-cube-2").unwrap();
+        let built = Built::new(&scene, PlieParams::thesis());
+        (scene, built)
+    })
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(64))]
+
+    /// Random points anywhere in the box, random sample sets on the light: per-light answers equal
+    /// per-ray answers and brute force in the P-LIE modes and the BVH.
+    #[test]
+    fn random_points_and_sample_sets(
+        p in (0.0f32..1.0, 0.0f32..1.0, 0.0f32..1.0),
+        us in prop::collection::vec((0.0f32..1.0, 0.0f32..1.0), 1..80),
+        give_leaf in any::<bool>(),
+    ) {
+        let (scene, built) = cornell();
+        let b = scene.bounds;
+        let x = b.min + (b.max - b.min) * Vec3::new(p.0, p.1, p.2);
+        let light = &scene.lights[0];
+        prop_assume!((x - light.vertices[0]).dot(light.normal) > 0.0);
+        let targets: Vec<Vec3> = us.iter().map(|&(u, v)| light.sample(Vec2::new(u, v))).collect();
+        let q = Query { x, tri: TriId(u32::MAX), leaf: if give_leaf { built.octree.locate(x) } else { None }, light: LightId(0), targets };
+        let rays = q.rays();
+        let mut ctx = QueryCtx::new(scene.triangles.len());
+        let brute = built.vis(scene, Mode::Brute);
+        for mode in [Mode::Bvh, Mode::Lie, Mode::Umbra, Mode::Penumbra, Mode::Grid] {
+            let vis = built.vis(scene, mode);
+            let mut out = vec![false; q.targets.len()];
+            vis.occluded_light(&rays, &mut out, &mut ctx);
+            for (k, &o) in out.iter().enumerate() {
+                prop_assert_eq!(o, vis.occluded(&rays.ray(k), &mut ctx), "{} sample {}", mode, k);
+                prop_assert_eq!(o, brute.occluded(&rays.ray(k), &mut ctx), "{} sample {}", mode, k);
+            }
+        }
+    }
+}
