@@ -114,12 +114,12 @@ pub fn default_scenes(shared: &Path) -> Vec<String> {
 
 /// Loads a scene with the table's camera: the README's for the shared files, else the scene's own.
 fn load(name: &str) -> Result<(Scene, Camera)> {
-    let args = crate::scene_arg::SceneArgs { scene: name.to_string(), eye: None, target: None, up: None, fov: None };
+    let args = crate::scene_arg::SceneArgs { scene: name.to_string() };
     let scene = args.load()?;
     let file = Path::new(name).file_name().and_then(|f| f.to_str()).unwrap_or("");
     let camera = match SHARED.iter().find(|(f, ..)| *f == file) {
         Some((_, eye, target, fov)) => Camera::new((*eye).into(), (*target).into(), glam::Vec3::Y, *fov)?,
-        None => args.camera(&scene)?,
+        None => scene.camera_or_default(),
     };
     Ok((scene, camera))
 }

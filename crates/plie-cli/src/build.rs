@@ -36,6 +36,9 @@ pub struct Args {
 pub fn run(a: &Args) -> Result<()> {
     crate::scenes::set_threads(a.threads)?;
     let scene = a.scene.load()?;
+    if !a.quiet {
+        crate::scene_arg::warn_about(&scene);
+    }
     let params = a.params.params(true)?;
     let bar = Bar::new(a.quiet || a.json);
     let t_all = Instant::now();
@@ -115,10 +118,10 @@ pub fn run(a: &Args) -> Result<()> {
         println!("{v}");
     } else if !a.quiet {
         println!(
-            "scene           {} ({} triangles, {} lights)",
+            "scene           {} ({} triangles, {})",
             scene.name,
             scene.triangle_count(),
-            scene.lights.len()
+            crate::scenes::count(scene.lights.len(), "light")
         );
         println!("octree          {} leaves, depth {} ({:.3} s)", octree.leaf_count(), octree.depth(), octree_seconds);
         println!(
@@ -166,8 +169,8 @@ pub fn run(a: &Args) -> Result<()> {
                 println!("                by rule: {}", rules.join(", "));
             }
             println!(
-                "                time saved ≈ {:.3} s (estimate: {:.2} ms per record computed, over the threads, minus propagation)",
-                stats.propagation_seconds_saved_estimate,
+                "                {} (estimate: {:.2} ms per record computed, over the threads, minus propagation)",
+                time_saved(stats.propagation_seconds_saved_estimate),
                 1e3 * stats.record_seconds_mean
             );
         }
@@ -218,4 +221,29 @@ fn print_refinement(params: &plie::lie::PlieParams, stats: &plie::construct::Bui
         u.seconds,
         stats.blockers_seconds
     );
+}
+
+/// The estimated construction time propagation saved, in words: a loss is said as one, and less than
+/// half a millisecond either way as under a millisecond (never "-0.000 s").
+fn time_saved(seconds: f64) -> String {
+    if seconds >= 0.0005 {
+        format!("time saved ≈ {seconds:.3} s")
+    } else if seconds <= -0.0005 {
+        format!("time lost ≈ {:.3} s (propagating cost more than it saved)", -seconds)
+    } else {
+        "time saved under a millisecond".to_string()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::time_saved;
+
+    #[test]
+    fn time_saved_never_reads_minus_zero() {
+        assert_eq!(time_saved(0.0123), "time saved ≈ 0.012 s");
+        assert_eq!(time_saved(-0.0000004), "time saved under a millisecond");
+        assert_eq!(time_saved(0.0004), "time saved under a millisecond");
+        assert_eq!(time_saved(-0.25), "time lost ≈ 0.250 s (propagating cost more than it saved)");
+    }
 }

@@ -17,13 +17,15 @@ use serde_json::{json, Value};
 use crate::image_args::ImageArgs;
 use crate::plie_args::{load_or_build, Loaded, PlieArgs};
 use crate::progress::Bar;
-use crate::scene_arg::{parse_vec3, SceneArgs};
+use crate::scene_arg::{parse_vec3, CameraArgs, SceneArgs};
 
 /// Options of `plie inspect`.
 #[derive(clap::Args)]
 pub struct Args {
     #[command(flatten)]
     scene: SceneArgs,
+    #[command(flatten)]
+    camera: CameraArgs,
     /// A point in the cell to show: the octree leaf containing it is inspected (and, with --summary,
     /// the only leaf listed).
     #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true)]
@@ -107,10 +109,10 @@ pub fn run(a: &Args) -> Result<()> {
     }
 
     let scene = a.scene.load()?;
-    if scene.degenerate_skipped > 0 && !a.quiet && !a.json {
-        eprintln!("warning: skipped {} degenerate (zero-area) triangles", scene.degenerate_skipped);
+    if !a.quiet && !a.json {
+        crate::scene_arg::warn_about(&scene);
     }
-    let camera = a.scene.camera(&scene)?;
+    let camera = a.camera.camera(&scene)?;
     let params = a.params.params(false)?;
     let bar = Bar::new(a.quiet || a.json);
     let Loaded { octree, plie, .. } = load_or_build(&scene, params, a.plie.as_deref(), &bar)?;

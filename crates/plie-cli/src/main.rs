@@ -27,15 +27,16 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
-    /// List the built-in scenes: name, triangles, lights.
+    /// List the built-in scenes: name, triangles, lights, and what each one is.
     Scenes(scenes::Args),
     /// Render a scene with direct lighting from its area lights.
     Render(Box<render::Args>),
-    /// Build the P-LIE of a scene and save it (.plie).
+    /// Build a scene's P-LIE and save it (.plie) for `plie render --plie`: per octree cell face and
+    /// light, the triangles that can block the light and where the face is fully or partly shadowed.
     Build(Box<build::Args>),
     /// Show what the P-LIE stores for a cell: a picture, a glTF scene, or a per-leaf summary.
     Inspect(Box<inspect::Args>),
-    /// Measure construction, shading and throughput per scene and mode (the thesis' protocol).
+    /// Measure P-LIE build, shading and shadow-ray throughput per scene and mode, and write a report.
     Bench(Box<bench::Args>),
 }
 

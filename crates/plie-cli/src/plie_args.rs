@@ -14,6 +14,9 @@ use plie::Scene;
 
 use crate::progress::Bar;
 
+/// The default of `--max-split-depth` (the thesis' test 2).
+pub const DEFAULT_MAX_SPLIT_DEPTH: u32 = 2;
+
 /// Options that set the octree and P-LIE parameters.
 #[derive(clap::Args, Clone, Debug)]
 pub struct PlieArgs {
@@ -23,28 +26,31 @@ pub struct PlieArgs {
     /// Octree: maximum depth.
     #[arg(long, default_value_t = OctreeParams::default().max_depth, value_name = "D")]
     pub max_depth: u32,
-    /// P-LIE: skip the face grids (per-cell blocker lists used by `--visibility grid`).
+    /// P-LIE: skip the face grids (the per-face grids of `--visibility grid`).
     #[arg(long)]
     pub no_grids: bool,
-    /// P-LIE: skip umbra and penumbra (SPEC §4.5) and the removal of fully dark records (§4.6), as
-    /// in the thesis' Table 8.4. Modes `umbra` and `penumbra` need them.
+    /// P-LIE: skip computing umbra and penumbra (where a face sees none or part of the light) and
+    /// the removal of faces fully in shadow; keep only blocker lists. Modes `umbra`, `penumbra` need
+    /// them.
     #[arg(long)]
     pub no_regions: bool,
-    /// P-LIE: do not propagate umbra to neighbouring cells (SPEC §4.7); every record's blockers are
-    /// computed. Same records except fully dark ones; only construction time changes.
+    /// P-LIE: do not carry full shadow over to neighbouring cells (which lets the build skip their
+    /// blockers); every face's blockers are computed. Same answers; only the build time changes.
     #[arg(long)]
     pub no_propagation: bool,
-    /// P-LIE: refine the octree after the records are known (SPEC §4.8), by a comma-separated chain
-    /// of criteria: `umbra` (rules 1 and 2), `umbra-full` (rule 1: a child face would be fully in
-    /// umbra), `umbra-free` (rule 2: a child face would have no blockers), `blockers` (more than
-    /// `--max-blockers` on one face and light). The thesis' test 2 is `--refine umbra`.
+    /// P-LIE: split octree cells further once their shadows are known, by a comma-separated list of
+    /// criteria: `umbra-full` (split where a smaller cell's face would lie fully in shadow),
+    /// `umbra-free` (where a smaller cell's face would need no blockers), `umbra` (both),
+    /// `blockers` (where a face has more than --max-blockers blockers for a light). Same answers;
+    /// more cells, usually faster shading.
     #[arg(long, value_name = "CRITERIA", value_delimiter = ',')]
     pub refine: Vec<RefineCriterion>,
-    /// Refinement: how many times a leaf may be split (thesis: 2).
-    #[arg(long, default_value_t = 2, value_name = "K")]
+    /// Refinement: how many times a leaf may be split (bounds a chain of criteria that would split
+    /// without end).
+    #[arg(long, default_value_t = DEFAULT_MAX_SPLIT_DEPTH, value_name = "K")]
     pub max_split_depth: u32,
     /// Refinement by `blockers`: split when one face and light has more blockers than N, or
-    /// `adaptive` (the scene's triangle count over twice the leaf's depth, thesis §8.3.3).
+    /// `adaptive` (the scene's triangle count over twice the cell's depth in the octree).
     #[arg(long, value_name = "N|adaptive", value_parser = parse_max_blockers)]
     pub max_blockers: Option<MaxBlockers>,
 }
@@ -52,13 +58,13 @@ pub struct PlieArgs {
 /// A value of `--refine`.
 #[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
 pub enum RefineCriterion {
-    /// Umbra rules 1 and 2.
+    /// Both umbra criteria.
     Umbra,
-    /// Umbra rule 1.
+    /// A smaller cell's face would lie fully in shadow.
     UmbraFull,
-    /// Umbra rule 2.
+    /// A smaller cell's face would need no blockers.
     UmbraFree,
-    /// Blockers per face and light.
+    /// More than --max-blockers blockers on one face for one light.
     Blockers,
 }
 

@@ -15,38 +15,48 @@ use serde_json::json;
 use crate::image_args::ImageArgs;
 use crate::plie_args::{load_or_build, PlieArgs};
 use crate::progress::Bar;
-use crate::scene_arg::SceneArgs;
+use crate::scene_arg::{CameraArgs, SceneArgs};
 
 /// Options of `plie render`.
 #[derive(clap::Args)]
 pub struct Args {
     #[command(flatten)]
     scene: SceneArgs,
+    #[command(flatten)]
+    camera: CameraArgs,
     /// Output image; the extension picks the format: .png, .exr, .pfm.
     #[arg(short = 'o', long = "output", value_name = "OUT")]
     output: PathBuf,
     #[command(flatten)]
     image: ImageArgs,
-    /// Visibility method: brute (every triangle), octree (SPEC mode a), bvh (modern BVH), lie (P-LIE
-    /// blockers, SPEC mode b), umbra (mode c), penumbra (mode d), grid (P-LIE face grids, ours),
-    /// embree (with the embree feature). All give the same image.
-    #[arg(long, default_value = "bvh", value_name = "MODE")]
-    visibility: Mode,
+    /// How shadow rays are answered. Every mode but `none` gives the same image, bit for bit; they
+    /// differ in speed. `brute`: test every triangle (the reference; slow). `octree`: walk the octree's
+    /// cells along the ray. `bvh`: a bounding volume hierarchy, the fastest without preprocessing.
+    /// `lie`: a P-LIE (built first, or read with --plie) lists, per cell face and light, the triangles
+    /// that can block the light; test only those. `umbra`: as `lie`, and a ray crossing the face in the
+    /// region the light cannot reach at all is dark without a test. `penumbra`: as `umbra`, and a ray
+    /// crossing the face where nothing blocks the light is lit without a test. `grid`: a grid on each
+    /// face says dark, lit, or which few blockers to test (the fastest P-LIE mode). `none`: no shadows
+    /// at all (not exact; a lower bound on shading time). `embree`: Intel Embree (only in a plie built
+    /// with `--features embree`). Default: `bvh`; with --plie, the fastest mode the file supports.
+    #[arg(long, value_name = "MODE")]
+    visibility: Option<Mode>,
     /// Worker threads (default: all cores). Images do not depend on it.
     #[arg(long, value_name = "T")]
     threads: Option<usize>,
     #[command(flatten)]
     params: PlieArgs,
-    /// Use this P-LIE file (from `plie build`) instead of building one (modes that need a P-LIE).
+    /// Use this P-LIE file (from `plie build`) instead of building one; only the P-LIE modes (`lie`,
+    /// `umbra`, `penumbra`, `grid`) use it. The octree options must be those it was built with.
     #[arg(long, value_name = "FILE.plie")]
     plie: Option<PathBuf>,
-    /// Print human-readable figures on stderr.
+    /// Print human-readable figures on stderr (times, shadow rays, and how a P-LIE answered them).
     #[arg(long)]
     stats: bool,
     /// Print one JSON object with the figures on stdout.
     #[arg(long)]
     json: bool,
-    /// No progress bar, no warnings.
+    /// No progress bar, no warnings, no `wrote FILE` line.
     #[arg(long, short)]
     quiet: bool,
 }
@@ -57,27 +67,35 @@ pub fn run(a: &Args) -> Result<()> {
     let t = Instant::now();
     let scene = a.scene.load()?;
     let load_seconds = t.elapsed().as_secs_f64();
-    if scene.degenerate_skipped > 0 && !a.quiet {
-        eprintln!("warning: skipped {} degenerate (zero-area) triangles", scene.degenerate_skipped);
+    if !a.quiet {
+        crate::scene_arg::warn_about(&scene);
     }
-    let camera = a.scene.camera(&scene)?;
+    let camera = a.camera.camera(&scene)?;
     plie::io::check_image_path(&a.output)?;
 
     let t = Instant::now();
     let bvh = Bvh::build(&scene);
     let bvh_seconds = t.elapsed().as_secs_f64();
     let bar = Bar::new(a.quiet || a.json);
+    let asked = a.visibility.unwrap_or(Mode::Bvh);
+    let plie_file = if a.visibility.is_none_or(Mode::needs_plie) { a.plie.as_deref() } else { None };
+    if !a.quiet {
+        for w in ignored_options(a, asked) {
+            eprintln!("warning: {w}");
+        }
+    }
     // Face grids only serve mode `grid`: other modes skip building them.
-    let params = a.params.params(a.visibility == Mode::Grid)?;
+    let params = a.params.params(asked == Mode::Grid)?;
     let t = Instant::now();
-    let (octree, plie, plie_seconds, load_plie_seconds) = if a.visibility.needs_plie() {
-        let got = load_or_build(&scene, params, a.plie.as_deref(), &bar)?;
-        (got.octree, Some(got.plie), got.build_seconds, got.load_seconds)
+    let (mode, octree, plie, plie_seconds, load_plie_seconds) = if asked.needs_plie() || plie_file.is_some() {
+        let got = load_or_build(&scene, params, plie_file, &bar)?;
+        let mode = a.visibility.unwrap_or_else(|| best_mode(&got.plie.params));
+        (mode, got.octree, Some(got.plie), got.build_seconds, got.load_seconds)
     } else {
-        (Octree::build(&scene, params.octree()), None, None, None)
+        (asked, Octree::build(&scene, params.octree()), None, None, None)
     };
     let octree_seconds = t.elapsed().as_secs_f64() - plie_seconds.unwrap_or(0.0);
-    let vis = visibility::for_mode(a.visibility, &scene, &bvh, &octree, plie.as_ref())?;
+    let vis = visibility::for_mode(mode, &scene, &bvh, &octree, plie.as_ref())?;
     let out = render(&scene, &camera, &settings, &bvh, Some(&octree), vis.as_ref(), &bar)?;
     let pixels = match plie::io::ImageFormat::from_path(&a.output)? {
         plie::io::ImageFormat::Png if a.image.exposure != 0.0 => {
@@ -97,7 +115,7 @@ pub fn run(a: &Args) -> Result<()> {
             "scene": scene.name,
             "triangles": scene.triangle_count(),
             "lights": scene.lights.len(),
-            "visibility": a.visibility.name(),
+            "visibility": mode.name(),
             "width": a.image.width,
             "height": a.image.height,
             "eye_rays": a.image.eye_rays,
@@ -134,12 +152,12 @@ pub fn run(a: &Args) -> Result<()> {
     }
     if a.stats {
         eprintln!(
-            "scene            {} ({} triangles, {} lights)",
+            "scene            {} ({} triangles, {})",
             scene.name,
             scene.triangle_count(),
-            scene.lights.len()
+            crate::scenes::count(scene.lights.len(), "light")
         );
-        eprintln!("visibility       {}", a.visibility);
+        eprintln!("visibility       {mode}");
         eprintln!(
             "image            {}x{}, {}x{} eye rays/pixel, {} shadow rays/light",
             a.image.width, a.image.height, a.image.eye_rays, a.image.eye_rays, a.image.shadow_rays
@@ -169,7 +187,7 @@ pub fn run(a: &Args) -> Result<()> {
         }
         print_answers(&s);
     }
-    if !a.quiet && !a.json && !a.stats {
+    if !a.quiet && !a.json {
         eprintln!("wrote {} ({:.2} s shading, {} shadow rays)", a.output.display(), out.shading_seconds, s.shadow_rays);
     }
     Ok(())
@@ -200,4 +218,47 @@ fn print_answers(s: &QueryStats) {
             eprintln!("  {name:<14} {n:>12} {:>6.1}%", share(n));
         }
     }
+}
+
+/// The fastest mode a P-LIE supports: `grid` with face grids, else `penumbra` with regions, else `lie`.
+fn best_mode(params: &plie::lie::PlieParams) -> Mode {
+    if params.grids {
+        Mode::Grid
+    } else if params.regions {
+        Mode::Penumbra
+    } else {
+        Mode::Lie
+    }
+}
+
+/// Options given that the chosen mode does not use, as warnings.
+fn ignored_options(a: &Args, mode: Mode) -> Vec<String> {
+    let mut out = Vec::new();
+    let p = &a.params;
+    let uses_plie = a.visibility.is_none_or(Mode::needs_plie) && (mode.needs_plie() || a.plie.is_some());
+    if let (Some(file), false) = (&a.plie, uses_plie) {
+        out.push(format!(
+            "--plie {} is ignored: --visibility {mode} does not use a P-LIE (lie, umbra, penumbra and grid do)",
+            file.display()
+        ));
+    }
+    if !uses_plie {
+        for (given, name) in [
+            (!p.refine.is_empty(), "--refine"),
+            (p.max_blockers.is_some(), "--max-blockers"),
+            (p.max_split_depth != crate::plie_args::DEFAULT_MAX_SPLIT_DEPTH, "--max-split-depth"),
+            (p.no_regions, "--no-regions"),
+            (p.no_propagation, "--no-propagation"),
+            (p.no_grids, "--no-grids"),
+        ] {
+            if given {
+                out.push(format!(
+                    "{name} is ignored: --visibility {mode} builds no P-LIE (lie, umbra, penumbra and grid do)"
+                ));
+            }
+        }
+    } else if p.no_grids && a.visibility.is_some_and(|m| m != Mode::Grid) {
+        out.push(format!("--no-grids is ignored: only --visibility grid uses face grids, not {mode}"));
+    }
+    out
 }

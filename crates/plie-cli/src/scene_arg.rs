@@ -1,4 +1,5 @@
-//! `--scene NAME|FILE` and the camera options shared by subcommands.
+//! `--scene NAME|FILE` (every subcommand) and `--eye`, `--target`, `--up`, `--fov` (those that render a
+//! picture).
 
 use std::path::Path;
 
@@ -7,19 +8,24 @@ use glam::Vec3;
 use plie::scene::builtin;
 use plie::{Camera, Scene};
 
-/// Options that choose the scene and camera.
+/// The option that chooses the scene.
 #[derive(clap::Args, Clone, Debug)]
 pub struct SceneArgs {
     /// A built-in scene name (see `plie scenes`) or a scene file (.obj with its .mtl, .gltf, .glb).
     #[arg(long, value_name = "NAME|FILE")]
     pub scene: String,
-    /// Camera position (default: the scene's camera).
+}
+
+/// Options that set the camera (subcommands that render a picture).
+#[derive(clap::Args, Clone, Debug)]
+pub struct CameraArgs {
+    /// Camera position (default: the scene's camera, or one framing the whole scene).
     #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true)]
     pub eye: Option<Vec3>,
     /// Point the camera looks at.
     #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true)]
     pub target: Option<Vec3>,
-    /// Camera up vector.
+    /// Camera up vector (image right = viewing direction x up).
     #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true)]
     pub up: Option<Vec3>,
     /// Vertical field of view in degrees.
@@ -42,7 +48,19 @@ impl SceneArgs {
         }
         plie::io::load_scene(path).with_context(|| format!("cannot load scene {}", path.display()))
     }
+}
 
+/// Warns (on stderr) about what the loader skipped or read without rendering.
+pub fn warn_about(scene: &Scene) {
+    if scene.degenerate_skipped > 0 {
+        eprintln!("warning: skipped {} degenerate (zero-area) triangles", scene.degenerate_skipped);
+    }
+    for w in &scene.warnings {
+        eprintln!("warning: {w}");
+    }
+}
+
+impl CameraArgs {
     /// The camera: the scene's (or a framing default), with any option given overriding a part.
     pub fn camera(&self, scene: &Scene) -> Result<Camera> {
         let base = scene.camera_or_default();

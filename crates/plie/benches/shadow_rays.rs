@@ -1,9 +1,12 @@
-//! Criterion benchmark: shadow-ray throughput of every visibility mode on built-in scenes, one
-//! thread, the same fixed set of shadow rays (points on triangles to light samples).
+//! Benchmark: shadow-ray throughput of every visibility mode on built-in scenes, one thread, the same
+//! fixed set of shadow rays (points on triangles to light samples): the median of 15 timed passes
+//! over the rays, after one warm-up pass. A plain timing loop rather than criterion, so that
+//! `cargo test` does not compile criterion and its dependencies; `plie bench` is the full protocol.
 //!
 //! Run with `cargo bench -p plie --bench shadow_rays`.
 
-use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
+use std::time::Instant;
+
 use glam::Vec2;
 use plie::lie::PlieParams;
 use plie::octree::Octree;
@@ -33,7 +36,13 @@ fn rays(scene: &Scene, octree: &Octree) -> Vec<ShadowRay> {
     out
 }
 
-fn bench(c: &mut Criterion) {
+/// Passes timed per mode; the median is reported.
+const PASSES: usize = 15;
+
+fn main() {
+    // `cargo test --benches` runs benchmarks with `--bench` absent: do one quick pass only.
+    let quick = !std::env::args().any(|a| a == "--bench");
+    println!("{:<16} {:<9} {:>12} {:>12}", "scene", "mode", "ns/ray", "Mrays/s");
     for name in ["cornell-cube-3", "huis-a", "dragon", "boot"] {
         let scene = plie::scene::builtin::load(name).expect("built-in scene");
         let params = PlieParams::thesis();
@@ -41,18 +50,20 @@ fn bench(c: &mut Criterion) {
         let (plie, _) = plie::construct::build(&scene, &octree, params, &NoProgress);
         let bvh = Bvh::build(&scene);
         let rays = rays(&scene, &octree);
-        let mut group = c.benchmark_group(format!("shadow_rays/{name}"));
-        group.throughput(Throughput::Elements(rays.len() as u64));
         for mode in Mode::EXACT.into_iter().filter(|m| *m != Mode::Brute) {
             let vis = for_mode(mode, &scene, &bvh, &octree, Some(&plie)).expect("mode");
             let mut ctx = QueryCtx::new(scene.triangle_count());
-            group.bench_with_input(BenchmarkId::from_parameter(mode), &rays, |b, rays| {
-                b.iter(|| rays.iter().filter(|r| vis.occluded(r, &mut ctx)).count())
-            });
+            let mut pass = || {
+                let t = Instant::now();
+                let blocked = rays.iter().filter(|r| vis.occluded(r, &mut ctx)).count();
+                std::hint::black_box(blocked);
+                t.elapsed().as_secs_f64()
+            };
+            pass();
+            let mut times: Vec<f64> = (0..if quick { 1 } else { PASSES }).map(|_| pass()).collect();
+            times.sort_by(f64::total_cmp);
+            let per_ray = times[times.len() / 2] / rays.len() as f64;
+            println!("{name:<16} {:<9} {:>12.1} {:>12.2}", mode.name(), per_ray * 1e9, 1e-6 / per_ray);
         }
-        group.finish();
     }
 }
-
-criterion_group!(benches, bench);
-criterion_main!(benches);

@@ -1,5 +1,6 @@
 //! SPEC §5 exactness: every visibility mode answers every shadow ray exactly as brute force, on every
-//! built-in scene and on the real scenes in ../shared/scenes/.
+//! built-in scene (10k rays each in the fast tier, 100k in the exhaustive one) and on the real scenes
+//! in ../shared/scenes/ (exhaustive tier).
 //!
 //! Shadow rays (what the renderer shoots: `y` on a light, `x` in front of it) start on triangles, on
 //! octree cell faces, edges and corners, and anywhere in the scene; every mode answers them. Free
@@ -17,7 +18,9 @@ use support::{shadow_rays, start_point, Built, TestRng};
 
 /// Scenes above this many triangles compare with brute force on a subsample only.
 const BRUTE_LIMIT: usize = 10_000;
+/// Shadow rays per scene: the exhaustive tier, and the fast tier (other rays: another seed).
 const SEGMENTS: usize = 100_000;
+const SEGMENTS_FAST: usize = 10_000;
 
 /// Free segments: axis-parallel ones and ones between any two points of the (slightly grown) box.
 fn free_segments(scene: &Scene, octree: &Octree, n: usize, seed: u64) -> Vec<ShadowRay> {
@@ -82,25 +85,34 @@ fn compare(scene: &Scene, built: &Built, what: &str, modes: &[Mode], rays: &[Sha
     }
 }
 
-fn check_scene(scene: &Scene) {
+fn check_scene(scene: &Scene, segments: usize, seed: u64) {
     let built = Built::new(scene, PlieParams::thesis());
-    let rays = shadow_rays(scene, &built.octree, SEGMENTS, 1234);
+    let rays = shadow_rays(scene, &built.octree, segments, seed);
     compare(scene, &built, "shadow ray", &Mode::EXACT, &rays);
     let free: Vec<Mode> = Mode::EXACT.into_iter().filter(|m| !m.needs_plie()).collect();
-    let segs = free_segments(scene, &built.octree, SEGMENTS / 4, 99);
+    let segs = free_segments(scene, &built.octree, segments / 4, seed + 1);
     compare(scene, &built, "free segment", &free, &segs);
 }
 
 #[test]
 fn every_mode_matches_brute_force_on_builtin_scenes() {
     for scene in support::builtins() {
-        check_scene(&scene);
+        check_scene(&scene, SEGMENTS_FAST, 5678);
     }
 }
 
 #[test]
+#[ignore = "exhaustive tier (100k rays per scene): cargo test --workspace -- --ignored"]
+fn every_mode_matches_brute_force_on_builtin_scenes_many_rays() {
+    for scene in support::builtins() {
+        check_scene(&scene, SEGMENTS, 1234);
+    }
+}
+
+#[test]
+#[ignore = "exhaustive tier (real scenes): cargo test --workspace -- --ignored"]
 fn every_mode_matches_brute_force_on_shared_scenes() {
     for scene in support::load_shared() {
-        check_scene(&scene);
+        check_scene(&scene, SEGMENTS, 1234);
     }
 }

@@ -54,6 +54,7 @@ fn images_are_bit_identical_across_modes_and_threads_builtin() {
 }
 
 #[test]
+#[ignore = "exhaustive tier (real scenes): cargo test --workspace -- --ignored"]
 fn images_are_bit_identical_across_modes_and_threads_shared() {
     let settings = RenderSettings { width: 32, height: 32, eye_rays: 1, shadow_rays: 4, seed: 9 };
     for scene in support::load_shared() {

@@ -2,8 +2,8 @@
 //! their README gives, every kind of bad input is an error naming the problem (never a panic), lights
 //! are grouped into convex polygons, and images round-trip exactly.
 //!
-//! Tests that need `shared/scenes` print a notice and pass when it is absent (set `PLIE_SCENES` to
-//! point elsewhere).
+//! Tests that need `../shared/scenes` (beside the workspace) are reported as ignored when it is absent
+//! (see `build.rs`).
 
 #[path = "io/gltf.rs"]
 mod gltf;
@@ -13,6 +13,7 @@ mod images;
 mod lights;
 #[path = "io/robustness.rs"]
 mod robustness;
+mod support;
 
 use std::path::{Path, PathBuf};
 
@@ -55,18 +56,9 @@ fn data(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data").join(name)
 }
 
-/// `shared/scenes`, or `None` (with a notice) when it is not there.
+/// `../shared/scenes`, beside the workspace: the only place the real scenes are looked for.
 fn scenes() -> Option<PathBuf> {
-    let candidates = [
-        std::env::var_os("PLIE_SCENES").map(PathBuf::from),
-        Some(Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/scenes")),
-        Some(PathBuf::from("/work/shared/scenes")),
-    ];
-    let found = candidates.into_iter().flatten().find(|p| p.join("README.md").is_file());
-    if found.is_none() {
-        eprintln!("NOTICE: shared/scenes not found (set PLIE_SCENES); skipping this test");
-    }
-    found
+    support::shared_scenes()
 }
 
 const V3: &[u8] = b"v 0 0 0\nv 1 0 0\nv 0 1 0\n";
@@ -90,6 +82,7 @@ fn check_real(file: &str, triangles: usize, lights: &[(usize, Vec3)]) -> Option<
 }
 
 #[test]
+#[cfg_attr(plie_no_shared_scenes, ignore = "needs ../shared/scenes, absent when the tests were built")]
 fn cornell_box_original() {
     let Some(s) = check_real("CornellBox-Original.obj", 36, &[(4, Vec3::new(17.0, 12.0, 4.0))]) else { return };
     let l = &s.lights[0];
@@ -100,6 +93,7 @@ fn cornell_box_original() {
 }
 
 #[test]
+#[cfg_attr(plie_no_shared_scenes, ignore = "needs ../shared/scenes, absent when the tests were built")]
 fn cornell_dragon() {
     let Some(s) = check_real("cornell-dragon.obj", 2766, &[(4, Vec3::new(17.0, 12.0, 4.0))]) else { return };
     assert!((s.lights[0].normal - Vec3::NEG_Y).length() < 1e-5);
@@ -107,25 +101,28 @@ fn cornell_dragon() {
 }
 
 #[test]
+#[cfg_attr(plie_no_shared_scenes, ignore = "needs ../shared/scenes, absent when the tests were built")]
 fn cornell_dragon_100k() {
     let lights = [(4, Vec3::new(17.0, 12.0, 4.0)), (4, Vec3::new(6.0, 8.0, 14.0))];
     check_real("cornell-dragon-100k.obj", 100_034, &lights);
 }
 
 #[test]
+#[cfg_attr(plie_no_shared_scenes, ignore = "needs ../shared/scenes, absent when the tests were built")]
 fn cornell_bunny() {
     check_real("cornell-bunny.obj", 69_483, &[(4, Vec3::new(17.0, 12.0, 4.0))]);
 }
 
 #[test]
+#[cfg_attr(plie_no_shared_scenes, ignore = "needs ../shared/scenes, absent when the tests were built")]
 fn boat_lit() {
     let Some(s) = check_real("boat-lit.obj", 7520, &[(4, Vec3::new(400.0, 380.0, 350.0))]) else { return };
     assert!(s.materials.iter().any(|m| m.name == "ground"));
 }
 
-/// Too big for the suite (331k triangles); run by hand with `--ignored`.
+/// 331k triangles: in the exhaustive tier.
 #[test]
-#[ignore]
+#[ignore = "exhaustive tier (a 331k-triangle file): cargo test --workspace -- --ignored"]
 fn conference_lit() {
     let Some(s) = check_real("conference-lit.obj", 331_183, &[(4, Vec3::new(12.0, 12.0, 11.0)); 2]) else { return };
     let m = s.materials.iter().find(|m| m.name == "mesh29_SG").unwrap();
@@ -133,6 +130,7 @@ fn conference_lit() {
 }
 
 #[test]
+#[cfg_attr(plie_no_shared_scenes, ignore = "needs ../shared/scenes, absent when the tests were built")]
 fn meshes_without_materials_have_no_lights() {
     let Some(dir) = scenes() else { return };
     for file in ["bunny.obj", "dragon_2734.obj", "dragon_100k.obj"] {

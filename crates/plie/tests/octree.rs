@@ -5,7 +5,7 @@
 //! the neighbour queries of every node in all 26 directions, and its leaves on each face, against a
 //! reference on integer cell coordinates.
 //!
-//! A hand-run timing is at the end: `cargo test -p plie --test octree -- --ignored --nocapture`.
+//! A hand-run timing is at the end: `cargo test -p plie --test octree hand_run_timing -- --ignored --nocapture`.
 
 use std::collections::HashMap;
 
@@ -612,10 +612,10 @@ fn leaves_on_faces_match_the_integer_reference() {
     }
 }
 
-/// Hand-run timing, no asserts on time.
+/// Hand-run timing, no asserts on time (the exhaustive tier skips it: `--skip hand_run_`).
 #[test]
-#[ignore]
-fn timing() {
+#[ignore = "hand-run timing, not a check: cargo test -p plie --test octree hand_run_timing -- --ignored --nocapture"]
+fn hand_run_timing() {
     use std::time::Instant;
     let s = if std::env::var("SMALL_SPHERE").is_ok() { sphere(40, 30) } else { sphere(1000, 300) };
     let t = Instant::now();

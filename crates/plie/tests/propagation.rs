@@ -133,6 +133,7 @@ fn propagated_records_are_dark_and_the_rest_unchanged_on_builtin_scenes() {
 }
 
 #[test]
+#[ignore = "exhaustive tier (real scenes): cargo test --workspace -- --ignored"]
 fn propagated_records_are_dark_and_the_rest_unchanged_on_shared_scenes() {
     for scene in support::load_shared() {
         if scene.triangles.len() > MAX_TRIANGLES {

@@ -71,6 +71,7 @@ fn refined_p_lies_are_exact_on_builtin_scenes() {
 }
 
 #[test]
+#[ignore = "exhaustive tier (real scenes): cargo test --workspace -- --ignored"]
 fn refined_p_lies_are_exact_on_shared_scenes() {
     let settings = RenderSettings { width: 24, height: 24, eye_rays: 1, shadow_rays: 4, seed: 13 };
     for scene in support::load_shared() {

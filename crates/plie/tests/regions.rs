@@ -130,6 +130,7 @@ fn regions_agree_with_the_blocker_test_on_builtin_scenes() {
 }
 
 #[test]
+#[ignore = "exhaustive tier (real scenes): cargo test --workspace -- --ignored"]
 fn regions_agree_with_the_blocker_test_on_shared_scenes() {
     if support::shared_scenes().is_none() {
         return;

@@ -4,7 +4,8 @@
 //! What is read: every mesh primitive of the default scene (or the first scene) with its node transform
 //! applied, in world space; modes TRIANGLES, TRIANGLE_STRIP and TRIANGLE_FAN, indexed or not; a node
 //! transform with negative determinant flips the winding (glTF rule). Material: base colour factor as
-//! albedo (textures ignored), `emissiveFactor` x `KHR_materials_emissive_strength` as emitted radiance;
+//! albedo (textures and metallic-roughness ignored, and reported in [`Scene::warnings`]),
+//! `emissiveFactor` x `KHR_materials_emissive_strength` as emitted radiance;
 //! primitives without material get a grey default (albedo 0.8). The first perspective camera met in a
 //! depth-first walk of the scene becomes the scene camera (position, `-z` as view direction and `+y` as
 //! up from its node transform, `yfov` in degrees). Skins and morph targets are ignored: meshes are
@@ -23,7 +24,7 @@ use ::gltf::{Accessor, Document, Semantic};
 use glam::{Mat4, Vec3};
 
 use super::lights::{self, EmissiveTriangle};
-use super::{parse_error, scene_name};
+use super::{material_warnings, parse_error, scene_name};
 use crate::error::{Error, Result};
 use crate::scene::{Camera, Material, MaterialId, Scene, SceneBuilder};
 
@@ -47,6 +48,7 @@ pub fn load_gltf(path: &Path) -> Result<Scene> {
         emissive: Vec::new(),
         emissive_info: Vec::new(),
         camera: None,
+        ignored: Vec::new(),
     };
     let mut seen = vec![false; doc.nodes().len()];
     let mut stack: Vec<(::gltf::Node, Mat4)> = scene.nodes().map(|n| (n, Mat4::IDENTITY)).collect();
@@ -184,6 +186,8 @@ struct Loader<'a> {
     /// Primitive description and triangle number of each emissive triangle, for errors.
     emissive_info: Vec<(String, usize)>,
     camera: Option<Camera>,
+    /// Material features read but not rendered: (what, material) ([`Scene::warnings`]).
+    ignored: Vec<(String, String)>,
 }
 
 impl Loader<'_> {
@@ -239,10 +243,20 @@ impl Loader<'_> {
         let mat = match m.index() {
             None => Material::diffuse("default", Vec3::splat(0.8)),
             Some(i) => {
-                let base = m.pbr_metallic_roughness().base_color_factor();
+                let pbr = m.pbr_metallic_roughness();
+                let base = pbr.base_color_factor();
+                let name = m.name().map_or_else(|| format!("material {i}"), str::to_string);
+                if pbr.metallic_factor() > 0.0 || pbr.metallic_roughness_texture().is_some() {
+                    let what = "metallic-roughness is not rendered: the base colour is shaded as a diffuse surface";
+                    self.ignored.push((what.to_string(), name.clone()));
+                }
+                if pbr.base_color_texture().is_some() || m.emissive_texture().is_some() {
+                    let what = "textures are not rendered: the flat colour factors are used";
+                    self.ignored.push((what.to_string(), name.clone()));
+                }
                 let strength = m.emissive_strength().unwrap_or(1.0);
                 Material {
-                    name: m.name().map_or_else(|| format!("material {i}"), str::to_string),
+                    name,
                     albedo: Vec3::new(base[0], base[1], base[2]).clamp(Vec3::ZERO, Vec3::ONE),
                     emission: Vec3::from(m.emissive_factor()) * strength,
                 }
@@ -282,10 +296,12 @@ impl Loader<'_> {
         if let Some(c) = self.camera {
             self.builder.camera(c);
         }
-        self.builder.build().map_err(|e| match e {
+        let mut scene = self.builder.build().map_err(|e| match e {
             Error::InvalidScene(m) => parse_error(path, None, m),
             e => e,
-        })
+        })?;
+        scene.warnings = material_warnings(&self.ignored);
+        Ok(scene)
     }
 }
 

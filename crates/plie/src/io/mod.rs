@@ -75,3 +75,22 @@ pub(crate) fn parse_error(path: &Path, line: Option<usize>, message: String) -> 
 pub(crate) fn scene_name(path: &Path) -> String {
     path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default()
 }
+
+/// Warnings about material features a file uses but plie does not render, from (what, material name)
+/// pairs: one per kind of feature, naming up to three materials ([`Scene::warnings`]).
+pub(crate) fn material_warnings(ignored: &[(String, String)]) -> Vec<String> {
+    let mut kinds: Vec<&str> = ignored.iter().map(|(what, _)| what.as_str()).collect();
+    kinds.sort_unstable();
+    kinds.dedup();
+    kinds
+        .into_iter()
+        .map(|what| {
+            let mut names: Vec<&str> = ignored.iter().filter(|(w, _)| w == what).map(|(_, m)| m.as_str()).collect();
+            names.dedup();
+            let shown = names.iter().take(3).map(|n| format!("'{n}'")).collect::<Vec<_>>().join(", ");
+            let more = if names.len() > 3 { format!(" and {} more", names.len() - 3) } else { String::new() };
+            let s = if names.len() == 1 { "" } else { "s" };
+            format!("material{s} {shown}{more}: {what}")
+        })
+        .collect()
+}

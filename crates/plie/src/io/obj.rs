@@ -7,8 +7,9 @@
 //! files `newmtl`, `Kd` (diffuse albedo, clamped to [0, 1]) and `Ke` (emitted radiance). A repeated
 //! `Kd` in one material: the last one counts, as in other OBJ readers. Everything else (normals, texture
 //! coordinates, `Ka`, `Ks`, `d`, `Tr`, maps, lines, points) is ignored: surfaces are opaque and
-//! Lambertian. An emissive triangle emits on the side its counter-clockwise winding faces; vertex
-//! normals are not used. Emissive triangles are grouped into lights by [`super::lights`].
+//! Lambertian; a non-zero `Ks` and a `map_Kd` (which would change how the scene looks) are reported
+//! in [`Scene::warnings`]. An emissive triangle emits on the side its counter-clockwise winding faces;
+//! vertex normals are not used. Emissive triangles are grouped into lights by [`super::lights`].
 //!
 //! Faces before any `usemtl` get a grey default material (albedo 0.8). Everything that would make a
 //! scene silently differ from its file is an error naming the file and line: a `mtllib` that cannot be
@@ -27,7 +28,7 @@ use glam::Vec3;
 
 use super::lights::{self, EmissiveTriangle};
 use super::obj_lines::{parse_finite, rest_after_keyword, strip_comment, LineFilter, LineRules};
-use super::{parse_error, scene_name};
+use super::{material_warnings, parse_error, scene_name};
 use crate::error::{Error, Result};
 use crate::scene::{Material, MaterialId, Scene, SceneBuilder};
 
@@ -51,7 +52,9 @@ pub fn load_obj(path: &Path) -> Result<Scene> {
         return Err(parse_error(path, None, "the file is empty".into()));
     }
     let has_mtllib = !libs.borrow().names.is_empty() || !libs.borrow().libs.is_empty();
-    build(path, &models, &materials, &reader.rules.tri_lines, has_mtllib)
+    let mut scene = build(path, &models, &materials, &reader.rules.tri_lines, has_mtllib)?;
+    scene.warnings = material_warnings(&libs.borrow().ignored);
+    Ok(scene)
 }
 
 /// State shared by the OBJ filter and the MTL loader.
@@ -65,6 +68,8 @@ struct Libraries {
     line: usize,
     /// The first error loading a library.
     error: Option<Error>,
+    /// MTL statements read but not rendered: (what, material).
+    ignored: Vec<(String, String)>,
 }
 
 /// Checks OBJ lines (module doc) and keeps what the loader needs to name lines later.
@@ -185,9 +190,20 @@ impl LineRules for ObjRules<'_> {
     }
 }
 
-/// Checks MTL lines: `newmtl` (recording the name), `Kd` and `Ke`; drops the rest.
+/// Checks MTL lines: `newmtl` (recording the name), `Kd` and `Ke`; drops the rest, noting in `libs`
+/// what a renderer of the file would have shown (a specular colour, a texture).
 struct MtlRules<'a> {
     libs: &'a RefCell<Libraries>,
+    /// The MTL file's directory (texture paths are relative to it).
+    dir: PathBuf,
+    /// The material being read.
+    material: String,
+}
+
+impl MtlRules<'_> {
+    fn ignore(&self, what: String) {
+        self.libs.borrow_mut().ignored.push((what, self.material.clone()));
+    }
 }
 
 impl LineRules for MtlRules<'_> {
@@ -202,7 +218,16 @@ impl LineRules for MtlRules<'_> {
                     return Err("newmtl without a name".into());
                 }
                 self.libs.borrow_mut().names.insert(name.to_string());
+                self.material = name.to_string();
                 let _ = write!(out, "newmtl {name}");
+            }
+            "Ks" if words.any(|w| w.parse::<f32>().is_ok_and(|v| v != 0.0)) => {
+                self.ignore("Ks (specular reflection) is not rendered: plie renders diffuse (Kd) only".into());
+            }
+            "map_Kd" => {
+                let file = rest_after_keyword(text, keyword).split_whitespace().last().unwrap_or("");
+                let missing = if self.dir.join(file).is_file() { "" } else { ", and the file is missing" };
+                self.ignore(format!("map_Kd textures are not rendered: the flat Kd colour is used{missing}"));
             }
             "Kd" | "Ke" => {
                 let tokens: Vec<&str> = words.take(4).collect();
@@ -264,7 +289,8 @@ fn load_library(obj: &Path, file: &Path, libs: &RefCell<Libraries>) -> tobj::MTL
     let f = File::open(file).map_err(|e| {
         fail(parse_error(obj, Some(line), format!("mtllib: cannot open material library {}: {e}", file.display())))
     })?;
-    let mut reader = LineFilter::new(BufReader::new(f), MtlRules { libs });
+    let dir = file.parent().unwrap_or(Path::new("")).to_path_buf();
+    let mut reader = LineFilter::new(BufReader::new(f), MtlRules { libs, dir, material: String::new() });
     let result = tobj::load_mtl_buf(&mut reader);
     if let Some((l, message)) = reader.error() {
         let e = parse_error(file, Some(*l), message.clone());

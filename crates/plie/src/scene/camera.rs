@@ -61,15 +61,26 @@ impl Camera {
         Ok(())
     }
 
-    /// A camera at the box's center plus `from` (a horizontal direction), looking back at the center
-    /// with y up, far enough that the box's bounding sphere fits the vertical field of view: the
-    /// default for scene files that carry no camera.
+    /// The default for scene files that carry no camera, like the "frame all" of other tools: a camera
+    /// looking at the box's center along the horizontal axis nearest to `from` (±x or ±z; -z if
+    /// `from` has no horizontal part), on the side `from` points to, y up, as close as it can be with
+    /// the whole box in view: the box's near face fills the vertical field of view with a 5% margin
+    /// (and the horizontal one too in square or wider images), centred in the picture.
     pub fn framing(bounds: &Aabb, fov_deg: f32, from: Vec3) -> Camera {
         let center = bounds.center();
-        let radius = (bounds.diagonal() * 0.5).max(1e-6);
-        let dist = radius / (fov_deg.to_radians() * 0.5).sin();
-        let from = Vec3::new(from.x, 0.0, from.z).try_normalize().unwrap_or(-Vec3::Z);
-        Camera { eye: center + from * dist, target: center, up: Vec3::Y, fov_deg }
+        let half = (bounds.size() * 0.5).max(Vec3::splat(1e-6));
+        let axis = if from.x.abs() > from.z.abs() {
+            Vec3::new(from.x.signum(), 0.0, 0.0)
+        } else if from.z != 0.0 {
+            Vec3::new(0.0, 0.0, from.z.signum())
+        } else {
+            -Vec3::Z
+        };
+        // Half the near face's width across the view, and half the box's depth along it.
+        let (across, depth) = if axis.x != 0.0 { (half.z, half.x) } else { (half.x, half.z) };
+        let tan_half = (fov_deg.to_radians() * 0.5).tan();
+        let dist = depth + 1.05 * across.max(half.y) / tan_half;
+        Camera { eye: center + axis * dist, target: center, up: Vec3::Y, fov_deg }
     }
 
     /// The frame for an image of `width` x `height` pixels.
@@ -113,6 +124,41 @@ mod tests {
         assert!(d.x < 0.0);
         let (_, d) = f.ray(50.0, 0.0);
         assert!(d.y > 0.0, "top row looks up");
+    }
+
+    /// The default camera frames a box: its center in the middle of the picture, every corner in
+    /// view, and the box filling the view (not a small part of it), whatever side it looks from.
+    #[test]
+    fn framing_centres_the_box_and_fills_the_view() {
+        // CornellBox-Original's bounds, and a flat wide box.
+        let boxes = [
+            Aabb::new(Vec3::new(-1.02, 0.0, -1.04), Vec3::new(1.0, 1.99, 0.99)),
+            Aabb::new(Vec3::new(10.0, -1.0, 3.0), Vec3::new(50.0, 2.0, 5.0)),
+        ];
+        let froms = [Vec3::Z, -Vec3::Z, Vec3::new(0.9, 0.3, 0.2), Vec3::new(-0.1, 0.0, -0.05), Vec3::Y];
+        for b in boxes {
+            for from in froms {
+                let c = Camera::framing(&b, 40.0, from);
+                c.validate().unwrap();
+                let f = c.frame(100, 100);
+                let ndc = |p: Vec3| {
+                    let d = p - f.eye;
+                    let z = d.dot(f.forward);
+                    assert!(z > 0.0, "{p} behind the camera");
+                    (d.dot(f.right) / (z * f.tan_half), d.dot(f.up) / (z * f.tan_half))
+                };
+                let (cx, cy) = ndc(b.center());
+                assert!(cx.abs() < 1e-5 && cy.abs() < 1e-5, "{b:?} from {from}: center at {cx}, {cy}");
+                let mut widest = 0.0f32;
+                for i in 0..8 {
+                    let p = Vec3::select(glam::BVec3::new(i & 1 != 0, i & 2 != 0, i & 4 != 0), b.max, b.min);
+                    let (x, y) = ndc(p);
+                    assert!(x.abs() <= 1.0 && y.abs() <= 1.0, "{b:?} from {from}: corner {p} out of view");
+                    widest = widest.max(x.abs()).max(y.abs());
+                }
+                assert!(widest > 0.9, "{b:?} from {from}: the box fills only {widest} of the view");
+            }
+        }
     }
 
     #[test]

@@ -30,6 +30,9 @@ pub struct Scene {
     pub bounds: Aabb,
     /// Degenerate (zero-area) triangles dropped while building.
     pub degenerate_skipped: usize,
+    /// What a scene file holds that plie reads but does not render (specular colours, textures,
+    /// metallic-roughness), one sentence each, for the caller to warn about; empty for built-ins.
+    pub warnings: Vec<String>,
 }
 
 impl Scene {
@@ -227,6 +230,7 @@ impl SceneBuilder {
             camera: self.camera,
             bounds,
             degenerate_skipped,
+            warnings: Vec::new(),
         })
     }
 }

@@ -90,6 +90,14 @@ impl FromStr for Mode {
     fn from_str(s: &str) -> Result<Mode, String> {
         Mode::all().find(|m| m.name() == s).ok_or_else(|| {
             let names: Vec<_> = Mode::all().map(|m| m.name()).collect();
+            if s == "embree" {
+                return format!(
+                    "this plie was built without Intel Embree; install Embree 3 (Debian: apt-get install \
+                     libembree-dev) and build with `cargo build --release -p plie-cli --features embree` \
+                     (or choose from {})",
+                    names.join(", ")
+                );
+            }
             format!("unknown visibility mode '{s}' (choose from {})", names.join(", "))
         })
     }

@@ -96,6 +96,27 @@ fn embedded_buffer() {
     check_scene(&s);
 }
 
+/// glTF's default metallic factor is 1: a material that does not set it to 0 would look metallic in
+/// a glTF viewer, so the loader says plie shades it as diffuse; the same for textures.
+#[test]
+fn metallic_roughness_and_textures_are_reported() {
+    let s = load_json(&embedded()).unwrap();
+    assert_eq!(s.warnings.len(), 1, "{:?}", s.warnings);
+    let w = &s.warnings[0];
+    assert!(w.starts_with("materials 'grey', 'lamp': metallic-roughness is not rendered"), "{w}");
+
+    let mut doc = embedded();
+    doc["materials"][0]["pbrMetallicRoughness"]["metallicFactor"] = json!(0.0);
+    doc["materials"][1]["pbrMetallicRoughness"] = json!({"metallicFactor": 0.0});
+    assert!(load_json(&doc).unwrap().warnings.is_empty());
+
+    doc["materials"][0]["pbrMetallicRoughness"]["baseColorTexture"] = json!({"index": 0});
+    doc["textures"] = json!([{"source": 0}]);
+    doc["images"] = json!([{"uri": "missing.png"}]);
+    let s = load_json(&doc).unwrap();
+    assert_eq!(s.warnings, ["material 'grey': textures are not rendered: the flat colour factors are used"]);
+}
+
 #[test]
 fn external_buffer_and_missing_buffer() {
     let doc = document(json!({"uri": "data.bin", "byteLength": 120}));

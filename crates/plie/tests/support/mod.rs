@@ -1,5 +1,8 @@
 //! Shared fixtures for the integration tests: a deterministic generator, the scenes to test on, and
-//! the real scenes in `../shared/scenes/` (skipped with a notice where that folder is absent).
+//! the real scenes in `../shared/scenes/`. Tests on the real scenes are in the exhaustive tier
+//! (`#[ignore]`d: `cargo test --workspace -- --ignored` runs them) or, when fast, compiled as ignored
+//! where the folder is absent (`build.rs` sets `plie_no_shared_scenes`); either way the summary
+//! counts them. Run where the folder is absent anyway, they print a notice and return.
 #![allow(dead_code)]
 
 use std::path::{Path, PathBuf};
@@ -43,7 +46,7 @@ pub fn shared_scenes() -> Option<PathBuf> {
     if dir.is_dir() {
         Some(dir)
     } else {
-        eprintln!("notice: {} not found; skipping the tests on real scenes", dir.display());
+        eprintln!("notice: {} not found; skipping the test on real scenes", dir.display());
         None
     }
 }

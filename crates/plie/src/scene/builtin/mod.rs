@@ -29,6 +29,24 @@ pub const NAMES: [&str; 10] = [
     "boot",
 ];
 
+/// One line on what the built-in scene `name` is and what it tests (`plie scenes`); `None` for an
+/// unknown name.
+pub fn description(name: &str) -> Option<&'static str> {
+    Some(match name {
+        "cornell-cube-1" => "Cornell room with a plane hovering under the light: every cell has a blocker",
+        "cornell-cube-2" => "the classic Cornell box: five walls, a short and a tall block, a ceiling light",
+        "cornell-cube-3" => "Cornell room with two finely tessellated spheres (960 triangles each)",
+        "cornell-cube-4" => "cornell-cube-2 with a second ceiling light",
+        "cornell-cube-5" => "cornell-cube-1 with a second light",
+        "huis-a" => "an office: ceiling light, two bookcases, two tables, an office chair",
+        "huis-b" => "huis-a with other colours, simpler bookcases and a flat screen on the desk",
+        "huis-c" => "huis-b with a second light, outside the camera's view",
+        "dragon" => "cornell-cube-2 with a dragon on a block: cells crowd around the dragon",
+        "boot" => "a boat on the water lit by one distant light: hardly any shadow",
+        _ => return None,
+    })
+}
+
 /// Builds the built-in scene `name`; [`Error::UnknownScene`] if there is none by that name.
 pub fn load(name: &str) -> Result<Scene> {
     let builder: SceneBuilder = match name {
