@@ -1,6 +1,7 @@
 //! Rendering, SPEC §2: the hit buffer (pass 1), then shading (pass 2) with a chosen visibility method.
 
 pub mod hit_buffer;
+pub mod path;
 pub mod sampler;
 pub mod shade;
 
