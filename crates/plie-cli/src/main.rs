@@ -4,13 +4,16 @@
 
 mod bench;
 mod bench_chart;
+mod bench_path;
 mod bench_report;
 mod build;
 mod image_args;
 mod inspect;
+mod path_args;
 mod plie_args;
 mod progress;
 mod render;
+mod render_path;
 mod scene_arg;
 mod scenes;
 
@@ -28,7 +31,7 @@ struct Cli {
 enum Command {
     /// List the built-in scenes: name, triangles, lights.
     Scenes(scenes::Args),
-    /// Render a scene with direct lighting from its area lights.
+    /// Render a scene: direct lighting from its area lights, or global illumination (--integrator path).
     Render(Box<render::Args>),
     /// Build the P-LIE of a scene and save it (.plie).
     Build(Box<build::Args>),
