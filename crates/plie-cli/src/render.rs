@@ -61,6 +61,8 @@ pub fn run(a: &Args) -> Result<()> {
     if a.path.integrator == Integrator::Direct {
         settings.eye_rays = a.path.eye_rays(settings.eye_rays)?;
         settings.validate()?;
+    } else {
+        a.path.settings(settings.eye_rays)?;
     }
     let t = Instant::now();
     let scene = a.scene.load()?;
