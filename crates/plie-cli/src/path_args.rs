@@ -37,7 +37,8 @@ pub struct PathArgs {
     #[arg(long, value_name = "K")]
     pub rr_depth: Option<u32>,
     /// Samples per pixel. Path: S paths per pixel, each through a random point of the pixel
-    /// (default K x K from --eye-rays), with --shadow-rays N light samples per light at every vertex.
+    /// (default K x K from --eye-rays), with --shadow-rays N light samples at every vertex (on one
+    /// light or on each, see --nee).
     /// Direct: S must be a square K x K and replaces --eye-rays K.
     #[arg(long, value_name = "S", conflicts_with = "eye_rays")]
     pub spp: Option<u32>,
