@@ -37,7 +37,7 @@ pub struct Args {
     /// Directory for report.md, results.csv, results.json and shading.svg (created if missing).
     #[arg(long, default_value = "bench-out", value_name = "DIR")]
     out: PathBuf,
-    /// Runs per measurement; the median is reported (default 5, 1 with --quick).
+    /// Runs per measurement; the median is reported (default 5, 1 with --quick and with --path).
     #[arg(long, value_name = "N")]
     runs: Option<usize>,
     /// Worker threads for the all-threads figures (default: all cores).
@@ -58,6 +58,17 @@ pub struct Args {
     /// With --soft-shadows: the folder of the shared scenes.
     #[arg(long, default_value = "../shared/scenes", value_name = "DIR")]
     shared: PathBuf,
+    /// Measure the path-tracing table instead (path.md, path.json): max depth 3 and 5, 16 paths per
+    /// pixel, on the ten built-in scenes and the conference room (default; --quick: cornell-cube-1 and
+    /// cornell-cube-3, 32x32).
+    #[arg(long)]
+    path: bool,
+    /// Path table: image width and height (default 64; 32 with --quick).
+    #[arg(long, value_name = "W")]
+    path_size: Option<u32>,
+    /// Path table: the visibility modes (default bvh,grid).
+    #[arg(long, value_name = "A,B,...", value_delimiter = ',')]
+    path_modes: Vec<Mode>,
 }
 
 /// What is measured: scenes, image settings, runs.
@@ -191,6 +202,9 @@ pub fn run(a: &Args) -> Result<()> {
         return crate::bench_soft::run(&scenes, &a.out, runs, a.quiet);
     }
     let plan = Plan::new(a)?;
+    if a.path {
+        return run_path(a, plan);
+    }
     let one = rayon::ThreadPoolBuilder::new().num_threads(1).build()?;
     let bar = Bar::new(a.quiet);
     bar.start("bench", plan.steps_per_scene() * plan.scenes.len() as u64);
@@ -214,6 +228,36 @@ pub fn run(a: &Args) -> Result<()> {
     crate::bench_report::write_all(&a.out, &a.thesis, &plan, &results)?;
     if !a.quiet {
         eprintln!("wrote {}/{{report.md, results.csv, results.json, shading.svg}}", a.out.display());
+    }
+    Ok(())
+}
+
+/// `plie bench --path`: the path-tracing table ([`crate::bench_path`]).
+fn run_path(a: &Args, plan: Plan) -> Result<()> {
+    let mut scenes = plan.scenes;
+    let conference = std::path::Path::new("../shared/scenes/conference-lit.obj");
+    if a.scenes.is_empty() && !a.quick {
+        if conference.exists() {
+            scenes.push(conference.display().to_string());
+        } else if !a.quiet {
+            eprintln!("notice: {} absent; the path table leaves out the conference room", conference.display());
+        }
+    }
+    let modes = if a.path_modes.is_empty() { vec![Mode::Bvh, Mode::Grid] } else { a.path_modes.clone() };
+    let size = a.path_size.unwrap_or(if a.quick { 32 } else { 64 });
+    anyhow::ensure!((1..=4096).contains(&size), "--path-size must be between 1 and 4096");
+    let p = crate::bench_path::PathPlan {
+        scenes,
+        size,
+        spp: 16,
+        shadow_rays: 4,
+        depths: vec![3, 5],
+        modes,
+        runs: a.runs.unwrap_or(1),
+    };
+    crate::bench_path::run(&p, &a.out, &Bar::new(a.quiet))?;
+    if !a.quiet {
+        eprintln!("wrote {}/{{path.md, path.json}}", a.out.display());
     }
     Ok(())
 }

@@ -4,14 +4,17 @@
 
 mod bench;
 mod bench_chart;
+mod bench_path;
 mod bench_report;
 mod bench_soft;
 mod build;
 mod image_args;
 mod inspect;
+mod path_args;
 mod plie_args;
 mod progress;
 mod render;
+mod render_path;
 mod scene_arg;
 mod scenes;
 
@@ -29,7 +32,7 @@ struct Cli {
 enum Command {
     /// List the built-in scenes: name, triangles, lights, and what each one is.
     Scenes(scenes::Args),
-    /// Render a scene with direct lighting from its area lights.
+    /// Render a scene: direct lighting from its area lights, or global illumination (--integrator path).
     Render(Box<render::Args>),
     /// Build a scene's P-LIE and save it (.plie) for `plie render --plie`: per octree cell face and
     /// light, the triangles that can block the light and where the face is fully or partly shadowed.

@@ -13,8 +13,10 @@ use plie::visibility::{self, Answer, Mode, QueryStats};
 use serde_json::json;
 
 use crate::image_args::ImageArgs;
+use crate::path_args::{Integrator, PathArgs};
 use crate::plie_args::{load_or_build, PlieArgs};
 use crate::progress::Bar;
+use crate::render_path;
 use crate::scene_arg::{CameraArgs, SceneArgs};
 
 /// Options of `plie render`.
@@ -29,6 +31,8 @@ pub struct Args {
     output: PathBuf,
     #[command(flatten)]
     image: ImageArgs,
+    #[command(flatten)]
+    path: PathArgs,
     /// How shadow rays are answered. Every mode but `none` gives the same image, bit for bit; they
     /// differ in speed. `brute`: test every triangle (the reference; slow). `octree`: walk the octree's
     /// cells along the ray. `bvh`: a bounding volume hierarchy, the fastest without preprocessing.
@@ -63,7 +67,13 @@ pub struct Args {
 
 pub fn run(a: &Args) -> Result<()> {
     crate::scenes::set_threads(a.threads)?;
-    let settings = a.image.settings()?;
+    let mut settings = a.image.settings()?;
+    if a.path.integrator == Integrator::Direct {
+        settings.eye_rays = a.path.eye_rays(settings.eye_rays)?;
+        settings.validate()?;
+    } else {
+        a.path.settings(settings.eye_rays)?;
+    }
     let t = Instant::now();
     let scene = a.scene.load()?;
     let load_seconds = t.elapsed().as_secs_f64();
@@ -96,6 +106,50 @@ pub fn run(a: &Args) -> Result<()> {
     };
     let octree_seconds = t.elapsed().as_secs_f64() - plie_seconds.unwrap_or(0.0);
     let vis = visibility::for_mode(mode, &scene, &bvh, &octree, plie.as_ref())?;
+    if a.path.integrator == Integrator::Path {
+        let setup = render_path::Setup {
+            scene: &scene,
+            camera: &camera,
+            settings,
+            bvh: &bvh,
+            octree: &octree,
+            vis: vis.as_ref(),
+            mode: mode,
+            bar: &bar,
+        };
+        let out = render_path::trace(&setup, &a.path)?;
+        let shadow_rays = out.stats.shadow_rays;
+        let seconds = out.seconds;
+        if a.json {
+            let mut v = render_path::json_fields(&out, &a.path, settings.eye_rays)?;
+            v["scene"] = json!(scene.name);
+            v["visibility"] = json!(mode.name());
+            v["width"] = json!(settings.width);
+            v["height"] = json!(settings.height);
+            v["shadow_rays_per_light"] = json!(settings.shadow_rays);
+            v["seed"] = json!(settings.seed);
+            v["threads"] = json!(rayon::current_num_threads());
+            v["build_seconds"] = json!(plie_seconds);
+            v["output"] = json!(a.output.display().to_string());
+            println!("{v}");
+        }
+        if a.stats {
+            eprintln!(
+                "scene            {} ({} triangles, {} lights)",
+                scene.name,
+                scene.triangle_count(),
+                scene.lights.len()
+            );
+            eprintln!("visibility       {}", mode);
+            render_path::print_stats(&out);
+            print_answers(&out.stats);
+        }
+        render_path::save(&a.output, &settings, a.image.exposure, out.pixels)?;
+        if !a.quiet && !a.json && !a.stats {
+            eprintln!("wrote {} ({seconds:.2} s path tracing, {shadow_rays} shadow rays)", a.output.display());
+        }
+        return Ok(());
+    }
     let out = render(&scene, &camera, &settings, &bvh, Some(&octree), vis.as_ref(), &bar)?;
     let pixels = match plie::io::ImageFormat::from_path(&a.output)? {
         plie::io::ImageFormat::Png if a.image.exposure != 0.0 => {
@@ -118,7 +172,8 @@ pub fn run(a: &Args) -> Result<()> {
             "visibility": mode.name(),
             "width": a.image.width,
             "height": a.image.height,
-            "eye_rays": a.image.eye_rays,
+            "integrator": "direct",
+            "eye_rays": settings.eye_rays,
             "shadow_rays_per_light": a.image.shadow_rays,
             "seed": a.image.seed,
             "threads": rayon::current_num_threads(),
@@ -160,7 +215,7 @@ pub fn run(a: &Args) -> Result<()> {
         eprintln!("visibility       {mode}");
         eprintln!(
             "image            {}x{}, {}x{} eye rays/pixel, {} shadow rays/light",
-            a.image.width, a.image.height, a.image.eye_rays, a.image.eye_rays, a.image.shadow_rays
+            a.image.width, a.image.height, settings.eye_rays, settings.eye_rays, a.image.shadow_rays
         );
         eprintln!("threads          {}", rayon::current_num_threads());
         eprintln!("load             {load_seconds:.3} s");

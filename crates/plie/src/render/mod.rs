@@ -2,6 +2,7 @@
 
 pub mod cpu_time;
 pub mod hit_buffer;
+pub mod path;
 pub mod sampler;
 pub mod shade;
 

@@ -67,7 +67,20 @@ impl Bvh {
     /// The nearest triangle hit by the ray `origin + t * dir` (`dir` unit length) with `t > 0`, and its
     /// `t`. Ties go to the first found, which is deterministic for a given BVH.
     pub fn closest_hit(&self, scene: &Scene, origin: Vec3, dir: Vec3) -> Option<(TriId, f32)> {
-        let test = RayTest::new(origin, dir, 0.0, f32::INFINITY);
+        self.closest_hit_from(scene, origin, dir, 0.0, None)
+    }
+
+    /// As [`Bvh::closest_hit`], for a ray leaving a surface (the bounce rays of the path tracer): only
+    /// hits with `t > t_min`, and never the triangle `skip` the ray starts on.
+    pub fn closest_hit_from(
+        &self,
+        scene: &Scene,
+        origin: Vec3,
+        dir: Vec3,
+        t_min: f32,
+        skip: Option<TriId>,
+    ) -> Option<(TriId, f32)> {
+        let test = RayTest::new(origin, dir, t_min, f32::INFINITY);
         // Unit direction in normalised space: t_local = t_world * scale.
         let ray = Ray::new(self.to_local(origin), Vec3A::from(dir), 0.0, f32::INFINITY);
         let mut best: Option<(TriId, f32)> = None;
@@ -76,6 +89,9 @@ impl Bvh {
         let mut r = ray;
         obvhs::traverse!(self.cw, node, state, node.intersect_ray(&r, state.oct_inv4), {
             let tri = self.cw.primitive_indices[state.primitive_id as usize];
+            if skip == Some(TriId(tri)) {
+                continue;
+            }
             if let Some(t) = test.hit(&scene.triangles[tri as usize]) {
                 let tl = t * self.scale;
                 if tl < r.tmax {

@@ -1,0 +1,102 @@
+//! `plie render --integrator path`: the path tracer (global illumination, SPEC §8 point 6) with
+//! next-event estimation through the chosen visibility mode; writes the image and prints its figures
+//! (rays by kind, time in shadow tests, shadow rays per second, the cost of locating path vertices).
+
+use anyhow::{Context, Result};
+use plie::octree::Octree;
+use plie::render::path::{render_path, PathRendered};
+use plie::render::RenderSettings;
+use plie::visibility::bvh::Bvh;
+use plie::visibility::{Mode, Visibility};
+use plie::{Camera, Scene};
+use serde_json::json;
+
+use crate::path_args::PathArgs;
+use crate::progress::Bar;
+
+/// What `plie render` has set up before the estimator runs.
+pub struct Setup<'a> {
+    pub scene: &'a Scene,
+    pub camera: &'a Camera,
+    pub settings: RenderSettings,
+    pub bvh: &'a Bvh,
+    pub octree: &'a Octree,
+    pub vis: &'a dyn Visibility,
+    pub mode: Mode,
+    pub bar: &'a Bar,
+}
+
+/// Path-traces and returns the image and its figures. Only the P-LIE modes locate path vertices in
+/// the octree (the others do not use the leaf).
+pub fn trace(s: &Setup, args: &PathArgs) -> Result<PathRendered> {
+    let path = args.settings(s.settings.eye_rays)?;
+    let octree = s.mode.needs_plie().then_some(s.octree);
+    Ok(render_path(s.scene, s.camera, &s.settings, &path, s.bvh, octree, s.vis, s.bar)?)
+}
+
+/// The figures of a path-traced image as JSON fields.
+pub fn json_fields(out: &PathRendered, args: &PathArgs, k: u32) -> Result<serde_json::Value> {
+    let path = args.settings(k)?;
+    let p = &out.path;
+    let s = &out.stats;
+    Ok(json!({
+        "integrator": "path",
+        "spp": path.spp,
+        "max_path_depth": path.max_depth,
+        "rr_depth": path.rr_depth,
+        "nee": path.nee,
+        "render_seconds": out.seconds,
+        "thread_seconds": p.thread_seconds,
+        "shadow_test_seconds": p.shadow_seconds,
+        "locate_seconds": p.locate_seconds,
+        "locates": p.locates,
+        "camera_rays": p.camera_rays,
+        "bounce_rays": p.bounce_rays,
+        "shadow_rays": s.shadow_rays,
+        "occluded": s.occluded,
+        "triangle_tests": s.triangle_tests,
+        "answers": s.answers,
+        "shadow_rays_per_second": s.shadow_rays as f64 / p.shadow_seconds.max(1e-9),
+    }))
+}
+
+/// Prints the figures of a path-traced image on stderr.
+pub fn print_stats(out: &PathRendered) {
+    let p = &out.path;
+    let s = &out.stats;
+    eprintln!("render           {:.3} s ({:.3} s summed over threads)", out.seconds, p.thread_seconds);
+    eprintln!(
+        "rays             {} camera, {} bounce, {} shadow ({:.1}% occluded)",
+        p.camera_rays,
+        p.bounce_rays,
+        s.shadow_rays,
+        100.0 * s.occluded as f64 / s.shadow_rays.max(1) as f64
+    );
+    eprintln!(
+        "shadow tests     {:.3} s summed over threads ({:.1}% of it), {:.2} M shadow rays/s",
+        p.shadow_seconds,
+        100.0 * p.shadow_seconds / p.thread_seconds.max(1e-9),
+        s.shadow_rays as f64 / p.shadow_seconds.max(1e-9) / 1e6
+    );
+    if p.locates > 0 {
+        eprintln!(
+            "locate leaves    {} vertices, {:.3} s summed over threads ({:.0} ns each)",
+            p.locates,
+            p.locate_seconds,
+            1e9 * p.locate_seconds / p.locates as f64
+        );
+    }
+}
+
+/// Writes the image (PNG scaled by 2^`exposure`).
+pub fn save(path: &std::path::Path, settings: &RenderSettings, exposure: f32, pixels: Vec<glam::Vec3>) -> Result<()> {
+    let pixels = match plie::io::ImageFormat::from_path(path)? {
+        plie::io::ImageFormat::Png if exposure != 0.0 => {
+            let k = exposure.exp2();
+            pixels.iter().map(|p| *p * k).collect()
+        }
+        _ => pixels,
+    };
+    plie::io::save_image(path, settings.width, settings.height, &pixels)
+        .with_context(|| format!("cannot write {}", path.display()))
+}
