@@ -114,7 +114,7 @@ pub fn run(a: &Args) -> Result<()> {
             bvh: &bvh,
             octree: &octree,
             vis: vis.as_ref(),
-            mode: mode,
+            mode,
             bar: &bar,
         };
         let out = render_path::trace(&setup, &a.path)?;
