@@ -5,6 +5,7 @@
 mod bench;
 mod bench_chart;
 mod bench_report;
+mod budget;
 mod build;
 mod image_args;
 mod inspect;

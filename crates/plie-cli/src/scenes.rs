@@ -15,7 +15,7 @@ pub fn run(args: &Args) -> Result<()> {
     if !args.json {
         println!("{:<16} {:>9} {:>6}", "name", "triangles", "lights");
     }
-    for name in builtin::NAMES {
+    for name in builtin::NAMES.into_iter().chain(builtin::STRESS) {
         let s = builtin::load(name)?;
         if args.json {
             let v = serde_json::json!({"name": name, "triangles": s.triangle_count(), "lights": s.lights.len()});
