@@ -31,7 +31,8 @@ pub struct Args {
     /// A short run: 1 run, cornell-cube-1 and cornell-cube-3, 32x32 eye rays, 4 shadow rays per light.
     #[arg(long)]
     quick: bool,
-    /// Scenes to measure: built-in names or scene files (default: the ten built-in scenes).
+    /// Scenes to measure: built-in names or scene files (default: the ten built-in scenes and the
+    /// stress scene `balusters`).
     #[arg(long, value_name = "A,B,...", value_delimiter = ',')]
     scenes: Vec<String>,
     /// Directory for report.md, results.csv, results.json and shading.svg (created if missing).
@@ -91,7 +92,7 @@ impl Plan {
         let scenes = match (a.scenes.is_empty(), a.quick) {
             (false, _) => a.scenes.clone(),
             (true, true) => vec!["cornell-cube-1".into(), "cornell-cube-3".into()],
-            (true, false) => builtin::NAMES.iter().map(|s| s.to_string()).collect(),
+            (true, false) => builtin::NAMES.iter().chain(&builtin::STRESS).map(|s| s.to_string()).collect(),
         };
         let (sizes, shadow_rays) = if a.quick { (vec![32], vec![4]) } else { (vec![126, 254], vec![4, 9]) };
         let modes: Vec<Mode> = Mode::EXACT.into_iter().filter(|m| *m != Mode::Brute).collect();
@@ -317,11 +318,12 @@ fn build_plie(
 fn bench_scene(name: &str, plan: &Plan, one: &rayon::ThreadPool, bar: &Bar) -> Result<SceneResult> {
     let (scene, camera) = load(name)?;
     let (bvh, bvh_seconds) = timed(plan.runs, || Bvh::build(&scene));
-    let thesis = PlieParams::thesis();
+    // The thesis' test-1 parameters with the default blocker cap (issue 15), as `plie build` uses.
+    let thesis = PlieParams::thesis().bounded();
     thesis.octree().validate()?;
     let (octree, octree_seconds) = timed(plan.runs, || Octree::build(&scene, thesis.octree()));
     let (_, lie, b1) = build_plie(&scene, &octree, thesis, "thesis", plan.runs);
-    let (_, grid, b2) = build_plie(&scene, &octree, PlieParams::default(), "grids", plan.runs);
+    let (_, grid, b2) = build_plie(&scene, &octree, PlieParams::default().bounded(), "grids", plan.runs);
     let no_regions = PlieParams { regions: false, ..thesis };
     let (_, _, b3) = build_plie(&scene, &octree, no_regions, "blockers-only", plan.runs);
     let no_propagation = PlieParams { propagation: false, ..thesis };

@@ -22,6 +22,11 @@ pub struct Args {
     output: PathBuf,
     #[command(flatten)]
     params: PlieArgs,
+    /// Memory budget of the construction, e.g. `4G`, `512M` (default: half the machine's memory). A
+    /// build that would exceed it stores the blocker lists of the records that do not fit no more
+    /// (they are answered by the scene BVH, exactly) and says so; it never aborts.
+    #[arg(long, value_name = "SIZE", value_parser = crate::budget::parse_bytes)]
+    memory_budget: Option<u64>,
     /// Worker threads (default: all cores). The result does not depend on it.
     #[arg(long, value_name = "T")]
     threads: Option<usize>,
@@ -34,18 +39,25 @@ pub struct Args {
 }
 
 pub fn run(a: &Args) -> Result<()> {
+    // First, so that Ctrl-C at any point before the file is written stops the build cleanly.
+    crate::progress::install_interrupt()?;
     crate::scenes::set_threads(a.threads)?;
     let scene = a.scene.load()?;
     if !a.quiet {
         crate::scene_arg::warn_about(&scene);
     }
     let params = a.params.params(true)?;
+    let budget = a.memory_budget.unwrap_or_else(crate::budget::default_bytes);
+    crate::budget::check(budget, &scene)?;
+    let limits = plie::construct::Limits { list_bytes: Some(crate::budget::list_bytes(budget, &scene)) };
     let bar = Bar::new(a.quiet || a.json);
     let t_all = Instant::now();
     let t = Instant::now();
     let octree = Octree::build(&scene, params.octree());
     let octree_seconds = t.elapsed().as_secs_f64();
-    let built = plie::construct::build_refined(&scene, octree, params, &bar);
+    let built = plie::construct::build_bounded(&scene, octree, params, limits, &bar)
+        .context("P-LIE construction stopped by Ctrl-C; nothing was written")?;
+    crate::budget::warn_over(&built.stats, &bar);
     let (octree, plie, mut stats) = (built.octree, built.plie, built.stats);
     stats.octree_seconds = octree_seconds;
     let build_seconds = t_all.elapsed().as_secs_f64();
@@ -53,6 +65,7 @@ pub fn run(a: &Args) -> Result<()> {
     let file_bytes = plie::io::plie_file::save_plie(&a.output, &scene, &octree, &plie)
         .with_context(|| format!("cannot write {}", a.output.display()))?;
     let write_seconds = t.elapsed().as_secs_f64();
+    let peak = crate::budget::peak_bytes();
     let memory = plie.memory_bytes() + octree.memory_bytes();
     if a.json {
         let propagation = json!({
@@ -74,7 +87,17 @@ pub fn run(a: &Args) -> Result<()> {
             "leaves_added": 7 * stats.refine_splits.values().sum::<usize>(),
             "unrefined": stats.unrefined,
         });
-        let v = json!({
+        // Issue 15: the bounds of the construction.
+        let bounded = json!({
+            "blocker_cap": params.blocker_cap,
+            "records_scene": stats.records_scene,
+            "records_over_budget": stats.records_over_budget,
+            "list_bytes": stats.list_bytes,
+            "memory_budget": budget,
+            "list_budget": limits.list_bytes,
+            "peak_memory_bytes": peak,
+        });
+        let mut v = json!({
             "scene": scene.name,
             "triangles": scene.triangle_count(),
             "lights": scene.lights.len(),
@@ -113,8 +136,12 @@ pub fn run(a: &Args) -> Result<()> {
             "grid_blockers_total": plie.cell_blockers.len(),
             "bytes": memory,
             "file_bytes": file_bytes,
+
             "output": a.output.display().to_string(),
         });
+        if let (Some(o), serde_json::Value::Object(b)) = (v.as_object_mut(), bounded) {
+            o.extend(b);
+        }
         println!("{v}");
     } else if !a.quiet {
         println!(
@@ -135,6 +162,13 @@ pub fn run(a: &Args) -> Result<()> {
             stats.blockers_max,
             stats.candidates_clipped,
             stats.blockers_seconds
+        );
+        println!(
+            "scene records   {} answered by the scene BVH ({} with more than {} blockers, {} over the memory budget of {budget} bytes)",
+            stats.records_scene,
+            stats.records_scene - stats.records_over_budget,
+            params.blocker_cap.map_or("no cap".to_string(), |c| c.to_string()),
+            stats.records_over_budget
         );
         if !params.regions {
             println!("regions         none (--no-regions)");
@@ -189,6 +223,9 @@ pub fn run(a: &Args) -> Result<()> {
         }
         println!("build           {build_seconds:.3} s");
         println!("memory          {memory} bytes (octree {} + P-LIE {})", octree.memory_bytes(), plie.memory_bytes());
+        if let Some(p) = peak {
+            println!("peak memory     {p} bytes (VmHWM)");
+        }
         println!("file            {} ({file_bytes} bytes, written in {write_seconds:.3} s)", a.output.display());
     }
     Ok(())

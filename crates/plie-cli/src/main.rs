@@ -7,6 +7,7 @@ mod bench_chart;
 mod bench_path;
 mod bench_report;
 mod bench_soft;
+mod budget;
 mod build;
 mod image_args;
 mod inspect;

@@ -1,6 +1,6 @@
 //! `--max-triangles`, `--max-depth`, `--no-grids`, `--no-regions`, `--no-propagation`, `--refine`,
-//! `--max-split-depth` and `--max-blockers`: the P-LIE build parameters (SPEC §4.9) shared by
-//! `plie build`, `plie render` and `plie inspect`.
+//! `--max-split-depth`, `--max-blockers` and `--blocker-cap`: the P-LIE build parameters (SPEC §4.9,
+//! issue 15) shared by `plie build`, `plie render` and `plie inspect`.
 
 use std::path::Path;
 use std::time::Instant;
@@ -53,6 +53,32 @@ pub struct PlieArgs {
     /// `adaptive` (the scene's triangle count over twice the cell's depth in the octree).
     #[arg(long, value_name = "N|adaptive", value_parser = parse_max_blockers)]
     pub max_blockers: Option<MaxBlockers>,
+    /// P-LIE: most blockers a record stores, or `none`; a record with more stores no list and its
+    /// rays are answered by the scene BVH (exact either way). Bounds construction time and memory.
+    #[arg(long, value_name = "N|none", default_value_t = BlockerCap(Some(plie::lie::DEFAULT_BLOCKER_CAP)), value_parser = parse_blocker_cap)]
+    pub blocker_cap: BlockerCap,
+}
+
+/// A value of `--blocker-cap`: a number, or `None` for `none`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct BlockerCap(pub Option<u32>);
+
+impl std::fmt::Display for BlockerCap {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self.0 {
+            Some(n) => write!(f, "{n}"),
+            None => f.write_str("none"),
+        }
+    }
+}
+
+fn parse_blocker_cap(s: &str) -> std::result::Result<BlockerCap, String> {
+    if s == "none" {
+        return Ok(BlockerCap(None));
+    }
+    s.parse::<u32>()
+        .map(|n| BlockerCap(Some(n)))
+        .map_err(|_| format!("expected a number of blockers or `none`, not `{s}`"))
 }
 
 /// A value of `--refine`.
@@ -87,6 +113,7 @@ impl PlieArgs {
             regions: !self.no_regions,
             propagation: !self.no_propagation,
             refine: self.refine_params()?,
+            blocker_cap: self.blocker_cap.0,
         };
         p.octree().validate()?;
         p.refine.validate(p.regions)?;
@@ -136,7 +163,10 @@ pub fn load_or_build(scene: &Scene, params: PlieParams, path: Option<&Path>, bar
     }
     let octree = Octree::build(scene, params.octree());
     let t = Instant::now();
-    let built = plie::construct::build_refined(scene, octree, params, bar);
+    let limits =
+        plie::construct::Limits { list_bytes: Some(crate::budget::list_bytes(crate::budget::default_bytes(), scene)) };
+    let built = plie::construct::build_bounded(scene, octree, params, limits, bar)?;
+    crate::budget::warn_over(&built.stats, bar);
     Ok(Loaded {
         octree: built.octree,
         plie: built.plie,

@@ -36,7 +36,7 @@ pub struct CameraArgs {
 impl SceneArgs {
     /// Loads the scene: a built-in name, else a file.
     pub fn load(&self) -> Result<Scene> {
-        if builtin::NAMES.contains(&self.scene.as_str()) {
+        if builtin::exists(&self.scene) {
             return Ok(builtin::load(&self.scene)?);
         }
         let path = Path::new(&self.scene);

@@ -16,7 +16,7 @@ pub fn run(args: &Args) -> Result<()> {
     if !args.json {
         println!("{:<16} {:>9} {:>6}  what", "name", "triangles", "lights");
     }
-    for name in builtin::NAMES {
+    for name in builtin::NAMES.into_iter().chain(builtin::STRESS) {
         let s = builtin::load(name)?;
         let what = builtin::description(name).unwrap_or("");
         if args.json {

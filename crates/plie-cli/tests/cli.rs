@@ -19,14 +19,14 @@ usemtl white\nf 1 3 2\nf 1 4 3\nusemtl lamp\nf 5 8 7\nf 5 7 6\n";
 const GOOD_MTL: &str = "newmtl white\nKd 0.8 0.8 0.8\nnewmtl lamp\nKd 0 0 0\nKe 5 5 5\n";
 
 #[test]
-fn scenes_lists_ten_scenes() {
+fn scenes_lists_ten_scenes_and_the_stress_scene() {
     let o = plie(&["scenes"]);
     assert!(o.status.success(), "{}", stderr(&o));
     let out = String::from_utf8_lossy(&o.stdout);
     for name in ["cornell-cube-1", "cornell-cube-5", "huis-a", "huis-c", "dragon", "boot"] {
         assert!(out.lines().any(|l| l.starts_with(name)), "missing {name} in {out}");
     }
-    assert_eq!(out.lines().count(), 11, "header + ten scenes: {out}");
+    assert_eq!(out.lines().count(), 12, "header + ten scenes + balusters: {out}");
 }
 
 #[test]
@@ -100,8 +100,17 @@ fn render_json_and_stats(dir: &Path, mode: &str) -> (serde_json::Value, String) 
     (serde_json::from_slice(&o.stdout).expect("one JSON object on stdout"), stderr(&o))
 }
 
-const PATHS: [&str; 8] =
-    ["no_record", "umbra", "lit", "blockers_hit", "blockers_miss", "own_leaf", "inside_leaf", "outside_octree"];
+const PATHS: [&str; 9] = [
+    "no_record",
+    "umbra",
+    "lit",
+    "blockers_hit",
+    "blockers_miss",
+    "own_leaf",
+    "inside_leaf",
+    "outside_octree",
+    "scene_bvh",
+];
 
 #[test]
 fn render_stats_and_json_report_how_shadow_rays_were_answered() {
@@ -117,6 +126,8 @@ fn render_stats_and_json_report_how_shadow_rays_were_answered() {
         let occluded: u64 = ["no_record", "umbra", "blockers_hit", "own_leaf"].iter().map(|k| path(k)).sum();
         assert_eq!(occluded, n("occluded"), "{mode}: {v}");
         assert!(path("blockers_hit") > 0, "{mode}: {v}");
+        // No record of this small scene reaches the blocker cap.
+        assert_eq!(path("scene_bvh"), 0, "{mode}: {v}");
         assert_eq!(n("blocker_tests") + n("own_leaf_tests"), n("triangle_tests"), "{mode}: {v}");
         let per_ray =
             v["blocker_tests_per_shadow_ray"].as_f64().unwrap() + v["own_leaf_tests_per_shadow_ray"].as_f64().unwrap();

@@ -167,7 +167,8 @@ fn lie_mode_matches_brute_force_in_the_room() {
         let (plie, stats) = plie::construct::build(&scene, &octree, params, &NoProgress);
         assert!(stats.grids > 0);
         let brute = Brute::new(&scene);
-        let modes = PLIE_MODES.map(|m| (m, LieVisibility::new(&scene, &octree, &plie, m)));
+        let bvh = plie::visibility::bvh::Bvh::build(&scene);
+        let modes = PLIE_MODES.map(|m| (m, LieVisibility::new(&scene, &bvh, &octree, &plie, m)));
         let mut ctx = QueryCtx::new(scene.triangles.len());
         let mut rng = Rng(5);
         let light = &scene.lights[0];
@@ -227,7 +228,8 @@ fn lie_mode_matches_brute_force_with_lights_tilted_to_grazing() {
     let octree = Octree::build(&scene, params.octree());
     let (plie, _) = plie::construct::build(&scene, &octree, params, &NoProgress);
     let brute = Brute::new(&scene);
-    let modes = PLIE_MODES.map(|m| (m, LieVisibility::new(&scene, &octree, &plie, m)));
+    let bvh = plie::visibility::bvh::Bvh::build(&scene);
+    let modes = PLIE_MODES.map(|m| (m, LieVisibility::new(&scene, &bvh, &octree, &plie, m)));
     let mut ctx = QueryCtx::new(scene.triangles.len());
     let mut rng = Rng(17);
     let (mut n, mut blocked) = (0, 0);

@@ -66,6 +66,9 @@ pub struct PendingGrid {
     pub cell_list: Vec<u32>,
     /// Cells fully in umbra (empty until the regions have classified them).
     pub umbra: Vec<bool>,
+    /// The grid of a [`crate::lie::RecordKind::Scene`] record: no lists; the cells not in umbra are
+    /// answered by the scene BVH.
+    pub scene: bool,
 }
 
 /// A square is split into four only if the four lists together hold at most this many times the
@@ -90,7 +93,13 @@ pub fn face_grid(
         return None;
     }
     let g = resolution(blockers.len(), min_res.max(2));
-    let mut out = PendingGrid { g, lists: Vec::new(), cell_list: vec![u32::MAX; (g * g) as usize], umbra: Vec::new() };
+    let mut out = PendingGrid {
+        g,
+        lists: Vec::new(),
+        cell_list: vec![u32::MAX; (g * g) as usize],
+        umbra: Vec::new(),
+        scene: false,
+    };
     let quad = Quad { scene, face, cell, light, tol, g };
     quad.split(0, 0, g, blockers, &mut out);
     debug_assert!(out.cell_list.iter().all(|&c| (c as usize) < out.lists.len()));

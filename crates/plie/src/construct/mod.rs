@@ -36,7 +36,7 @@ use rayon::prelude::*;
 
 use serde::Serialize;
 
-use crate::lie::{FaceGrid, Plie, PlieParams, Record, RecordRegions, NO_RECORD, UMBRA_CELL};
+use crate::lie::{FaceGrid, Plie, PlieParams, Record, RecordKind, RecordRegions, NO_RECORD, SCENE_CELL, UMBRA_CELL};
 use crate::octree::{Dir, LeafId, Octree};
 use crate::render::Progress;
 use crate::scene::{LightId, Scene, TriId};
@@ -60,6 +60,21 @@ pub(crate) fn abs_scale(octree: &Octree) -> f32 {
     octree.root_bounds().min.abs().max(octree.root_bounds().max.abs()).max_element()
 }
 
+/// Limits of one construction that are not part of the P-LIE's parameters (issue 15).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Limits {
+    /// Bytes the blocker lists of the records and grid cells may take. A listed record that would
+    /// pass it is stored as [`RecordKind::Scene`] instead (degrading, never aborting); the decision is
+    /// made at the record's commit, in task order, so it does not depend on the thread count. `None`:
+    /// no limit.
+    pub list_bytes: Option<usize>,
+}
+
+/// The construction was interrupted ([`Progress::cancelled`]); nothing was built.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, thiserror::Error)]
+#[error("interrupted")]
+pub struct Interrupted;
+
 /// Named counters and stage times of one construction.
 #[derive(Clone, Debug, Default, PartialEq, Serialize)]
 pub struct BuildStats {
@@ -79,6 +94,13 @@ pub struct BuildStats {
     pub blockers_mean: f64,
     /// Most blockers on one record.
     pub blockers_max: u32,
+    /// Records answered by the scene BVH ([`RecordKind::Scene`]): more blockers than the cap, or over
+    /// the memory budget.
+    pub records_scene: usize,
+    /// Of those, the records whose lists did not fit [`Limits::list_bytes`].
+    pub records_over_budget: usize,
+    /// Bytes of the blocker lists stored (records and grid cells).
+    pub list_bytes: usize,
     /// Records removed because their face lies fully in umbra (§4.6).
     pub records_removed_umbra: usize,
     /// Records deleted by propagation (§4.7) without computing their blockers.
@@ -151,6 +173,38 @@ struct PendingRecord {
     blockers: Vec<TriId>,
     regions: Option<regions::FaceRegions>,
     grid: Option<grid::PendingGrid>,
+    kind: RecordKind,
+}
+
+impl PendingRecord {
+    /// A [`RecordKind::Scene`] record: no list and no penumbra; its umbra (from a subset of the
+    /// blockers) is kept, with a grid of umbra cells when there is some umbra and grids are on.
+    fn scene(regions: Option<regions::FaceRegions>, grids: bool) -> PendingRecord {
+        let regions = regions.map(|mut r| {
+            r.penumbra = Vec::new();
+            r.penumbra_fraction = 0.0;
+            r
+        });
+        let grid = regions.as_ref().filter(|r| grids && !r.umbra.is_empty()).map(|r| grid::PendingGrid {
+            g: grid::UMBRA_MIN_RES,
+            lists: Vec::new(),
+            cell_list: Vec::new(),
+            umbra: grid::umbra_cells(grid::UMBRA_MIN_RES, r),
+            scene: true,
+        });
+        PendingRecord { blockers: Vec::new(), regions, grid, kind: RecordKind::Scene }
+    }
+
+    /// Bytes its blocker lists (record and grid cells) will take in the P-LIE.
+    fn list_bytes(&self) -> usize {
+        let cells: usize = self.grid.iter().flat_map(|g| &g.lists).map(Vec::len).sum();
+        (self.blockers.len() + cells) * std::mem::size_of::<TriId>()
+    }
+
+    /// Turns a listed record into a [`RecordKind::Scene`] one (over the memory budget).
+    fn into_scene(self, grids: bool) -> PendingRecord {
+        PendingRecord::scene(self.regions, grids)
+    }
 }
 
 /// What was computed for one (leaf, light): a record per face, the faces' new states, counters.
@@ -196,6 +250,19 @@ pub fn build_traced(scene: &Scene, octree: &Octree, params: PlieParams, progress
 /// Builds the P-LIE of `scene` over `octree` (stages 1-6) and refines the octree as `params.refine`
 /// asks (stage 7), returning the refined octree with it.
 pub fn build_refined(scene: &Scene, octree: Octree, params: PlieParams, progress: &dyn Progress) -> Built {
+    build_bounded(scene, octree, params, Limits::default(), progress)
+        .expect("construction interrupted: use build_bounded with a progress that can cancel")
+}
+
+/// [`build_refined`] within `limits`; returns [`Interrupted`] as soon as `progress` says
+/// [`Progress::cancelled`].
+pub fn build_bounded(
+    scene: &Scene,
+    octree: Octree,
+    params: PlieParams,
+    limits: Limits,
+    progress: &dyn Progress,
+) -> Result<Built, Interrupted> {
     let t0 = Instant::now();
     let triangles = scene.triangles.len();
     let max_split = params.refine.max_split_depth;
@@ -210,7 +277,7 @@ pub fn build_refined(scene: &Scene, octree: Octree, params: PlieParams, progress
     let (mut tests, mut wasted, mut propagation_seconds) = (0, 0, 0.0);
     let round = loop {
         let stage = if splits.is_empty() { "blockers".to_string() } else { format!("refine {}", splits.len()) };
-        let round = run_round(scene, &octree, params, progress, &stage, prior.take());
+        let round = run_round(scene, &octree, params, limits, progress, &stage, prior.take())?;
         tests += round.tests;
         wasted += round.wasted;
         propagation_seconds += round.seconds;
@@ -228,7 +295,13 @@ pub fn build_refined(scene: &Scene, octree: Octree, params: PlieParams, progress
             .map(|&l| {
                 let faces: Vec<refine::FaceView> = (0..lights)
                     .flat_map(|i| round.tasks[l.idx() * lights + i].records.iter().flatten())
-                    .map(|r| refine::FaceView { blockers: r.blockers.len(), regions: r.regions.as_ref() })
+                    .map(|r| match r.kind {
+                        RecordKind::Listed => {
+                            refine::FaceView { blockers: r.blockers.len(), regions: r.regions.as_ref() }
+                        }
+                        // More blockers than the cap; its regions lack the penumbra.
+                        RecordKind::Scene => refine::FaceView { blockers: usize::MAX, regions: None },
+                    })
                     .collect();
                 refine::decide(&faces, &params.refine, triangles, octree.leaf_depth(l))
             })
@@ -255,7 +328,7 @@ pub fn build_refined(scene: &Scene, octree: Octree, params: PlieParams, progress
         prior = Some(Prior { round, origin });
         octree = refined;
     };
-    let Round { tasks, propagator_log: propagated, states, .. } = round;
+    let Round { tasks, propagator_log: propagated, states, over_budget, .. } = round;
     let lights = scene.lights.len();
     let mut stats = BuildStats {
         leaves: octree.leaf_count(),
@@ -267,6 +340,7 @@ pub fn build_refined(scene: &Scene, octree: Octree, params: PlieParams, progress
         unrefined,
         ..Default::default()
     };
+    stats.records_over_budget = over_budget;
     let mut plie = flatten(&octree, params, lights, tasks, &mut stats);
     plie.splits = splits;
     stats.propagation_tests = tests;
@@ -281,7 +355,7 @@ pub fn build_refined(scene: &Scene, octree: Octree, params: PlieParams, progress
     stats.propagation_seconds_saved_estimate =
         stats.records_removed_propagation as f64 * stats.record_seconds_mean / threads - propagation_seconds;
     stats.blockers_seconds = t0.elapsed().as_secs_f64();
-    Built { octree, plie, stats, propagated }
+    Ok(Built { octree, plie, stats, propagated })
 }
 
 /// What one round computed: every (leaf, light) task's records, every face's state, and what
@@ -293,6 +367,8 @@ struct Round {
     tests: usize,
     wasted: usize,
     seconds: f64,
+    /// Records stored as [`RecordKind::Scene`] because their lists did not fit the budget.
+    over_budget: usize,
 }
 
 impl Round {
@@ -321,10 +397,11 @@ fn run_round(
     scene: &Scene,
     octree: &Octree,
     params: PlieParams,
+    limits: Limits,
     progress: &dyn Progress,
     stage: &str,
     prior: Option<Prior>,
-) -> Round {
+) -> Result<Round, Interrupted> {
     let tol = tolerance(scene, octree);
     let lights = scene.lights.len();
     let abs_scale = abs_scale(octree);
@@ -357,7 +434,11 @@ fn run_round(
     // Set at the commit that deletes a face: workers skip it (a face deleted later is computed anyway,
     // and its result discarded at its own commit).
     let deleted: Vec<AtomicBool> = (0..states.len()).map(|_| AtomicBool::new(false)).collect();
-    let mut commits = Commits { states, propagator, tasks, lights, propagate, seconds: 0.0, wasted: 0 };
+    // The budget counts the lists of the records carried over from the previous round too.
+    let used = tasks.iter().flat_map(|t| t.records.iter().flatten()).map(PendingRecord::list_bytes).sum();
+    let budget = Budget { limit: limits.list_bytes, used, over: 0, grids: params.grids };
+    let mut commits = Commits { states, propagator, tasks, lights, propagate, seconds: 0.0, wasted: 0, budget };
+    let cancelled = AtomicBool::new(false);
     let scratches: Vec<Mutex<GatherScratch>> = (0..rayon::current_num_threads().max(1))
         .map(|_| Mutex::new(GatherScratch::new(scene.triangles.len())))
         .collect();
@@ -367,6 +448,10 @@ fn run_round(
         // Stages 2-5 for the task's faces that are pending and not deleted yet.
         |k| {
             let (leaf, light) = order[k];
+            if cancelled.load(Ordering::Relaxed) || progress.cancelled() {
+                cancelled.store(true, Ordering::Relaxed);
+                return None;
+            }
             // One scratch per worker thread (a task never waits for another).
             let slot = &scratches[rayon::current_thread_index().unwrap_or(0) % scratches.len()];
             let mut scratch = slot.lock().unwrap_or_else(|e| e.into_inner());
@@ -377,13 +462,43 @@ fn run_round(
                 todo.then(|| face_record(scene, octree, (leaf, light), face, &tols, abs_scale, params, &mut scratch))
             });
             progress.advance(1);
-            out
+            Some(out)
         },
-        |k, out| commits.commit(order[k], out, &deleted),
+        |k, out| {
+            if let Some(out) = out {
+                commits.commit(order[k], out, &deleted);
+            }
+        },
     );
     progress.finish();
-    let Commits { states, propagator, tasks, seconds, wasted, .. } = commits;
-    Round { tasks, states, propagator_log: propagator.log, tests: propagator.tests, wasted, seconds }
+    if cancelled.load(Ordering::Relaxed) {
+        return Err(Interrupted);
+    }
+    let Commits { states, propagator, tasks, seconds, wasted, budget, .. } = commits;
+    let over_budget = budget.over;
+    Ok(Round { tasks, states, propagator_log: propagator.log, tests: propagator.tests, wasted, seconds, over_budget })
+}
+
+/// The memory budget of the blocker lists, spent at the commits in task order.
+struct Budget {
+    limit: Option<usize>,
+    used: usize,
+    /// Records turned into [`RecordKind::Scene`] because they did not fit.
+    over: usize,
+    grids: bool,
+}
+
+impl Budget {
+    /// `rec` if its lists fit the budget (spending it), else `rec` as a [`RecordKind::Scene`] record.
+    fn spend(&mut self, rec: PendingRecord) -> PendingRecord {
+        let bytes = rec.list_bytes();
+        if self.limit.is_some_and(|l| self.used + bytes > l) && rec.kind == RecordKind::Listed {
+            self.over += 1;
+            return rec.into_scene(self.grids);
+        }
+        self.used += bytes;
+        rec
+    }
 }
 
 /// What the commits own, in task order: the faces' states, the propagator and the results.
@@ -397,6 +512,7 @@ struct Commits<'a> {
     seconds: f64,
     /// Faces computed, then found deleted at their commit.
     wasted: usize,
+    budget: Budget,
 }
 
 impl Commits<'_> {
@@ -416,7 +532,7 @@ impl Commits<'_> {
             }
             let fo = fo.expect("a face pending at its task's commit was computed");
             self.states.set(leaf, face, light, fo.state);
-            t.records[face.index()] = fo.record;
+            t.records[face.index()] = fo.record.map(|r| self.budget.spend(r));
             t.computed[face.index()] = Some(fo.state);
             t.candidates += fo.candidates;
             t.removed_umbra += matches!(fo.state, FaceState::Dark { .. }) as usize;
@@ -495,7 +611,9 @@ fn flatten(
                     light,
                     blockers_start: plie.blockers.len() as u32,
                     blockers_len: rec.blockers.len() as u32,
+                    kind: rec.kind,
                 });
+                stats.records_scene += (rec.kind == RecordKind::Scene) as usize;
                 plie.blockers.extend(rec.blockers);
             }
         }
@@ -509,6 +627,7 @@ fn flatten(
         stats.penumbra_fraction_mean = penumbra_sum / stats.records as f64;
     }
     stats.blockers_total = plie.blockers.len();
+    stats.list_bytes = (plie.blockers.len() + plie.cell_blockers.len()) * std::mem::size_of::<TriId>();
     (stats.blockers_mean, stats.blockers_max) = plie.blocker_stats();
     plie
 }
@@ -525,13 +644,16 @@ fn flatten_grid(grid: Option<grid::PendingGrid>, plie: &mut Plie, stats: &mut Bu
         ranges.push((plie.cell_blockers.len() as u32, l.len() as u32));
         plie.cell_blockers.extend(l);
     }
-    for (i, c) in pg.cell_list.into_iter().enumerate() {
+    let cells = (pg.g * pg.g) as usize;
+    for i in 0..cells {
         stats.grid_cells += 1;
         if pg.umbra.get(i).copied().unwrap_or(false) {
             stats.grid_cells_umbra += 1;
             plie.cells.push(UMBRA_CELL);
+        } else if pg.scene {
+            plie.cells.push(SCENE_CELL);
         } else {
-            let r = ranges[c as usize];
+            let r = ranges[pg.cell_list[i] as usize];
             stats.grid_cells_lit += (r.1 == 0) as usize;
             plie.cells.push(r);
         }
@@ -566,11 +688,18 @@ fn face_record(
     let corners = face.face_corners(&b);
     let shaft = Shaft::new(&corners, &light.vertices, tol);
     let mut blockers = Vec::new();
-    let candidates = gather_blockers(scene, octree, &shaft, light_id, scratch, &mut blockers);
-    let regions =
-        params.regions.then(|| regions::face_regions(scene, face, &b, light, &blockers, &shaft, tol, abs_scale));
+    let cap = params.blocker_cap.map(|c| c as usize);
+    let gathered = gather_blockers(scene, octree, &shaft, light_id, cap, scratch, &mut blockers);
+    // Capped: `blockers` is a subset, whose umbra is a subset of the true umbra (still sound); its
+    // penumbra is not needed.
+    let regions = params.regions.then(|| {
+        let f = if gathered.capped { regions::face_umbra } else { regions::face_regions };
+        f(scene, face, &b, light, &blockers, &shaft, tol, abs_scale)
+    });
     let (record, state) = if let Some(reg) = regions.as_ref().filter(|r| r.full_umbra) {
         (None, FaceState::Dark { budget: propagation::dark_budget(face, &b, light, reg, tols) })
+    } else if gathered.capped {
+        (Some(PendingRecord::scene(regions, params.grids)), FaceState::Kept)
     } else {
         let has_umbra = regions.as_ref().is_some_and(|r| !r.umbra.is_empty());
         let mut grid = if params.grids {
@@ -589,7 +718,8 @@ fn face_record(
                 crate::geometry::morton::sort_spatially(scene, list);
             }
         }
-        (Some(PendingRecord { blockers, regions, grid }), FaceState::Kept)
+        (Some(PendingRecord { blockers, regions, grid, kind: RecordKind::Listed }), FaceState::Kept)
     };
+    let candidates = gathered.candidates;
     FaceOut { record, state, candidates, seconds: t0.elapsed().as_secs_f64() }
 }

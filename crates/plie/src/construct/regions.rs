@@ -253,6 +253,37 @@ pub fn face_regions(
     tol: f32,
     abs_scale: f32,
 ) -> FaceRegions {
+    regions(scene, face, cell, light, blockers, shaft, (tol, abs_scale), true)
+}
+
+/// [`face_regions`] without the penumbra (left empty): for a record that stores no list
+/// ([`crate::lie::RecordKind::Scene`]), whose `blockers` are only some of its blockers. Their umbra is
+/// part of the true umbra; their penumbra would not bound the true one, so it is not computed.
+#[allow(clippy::too_many_arguments)]
+pub fn face_umbra(
+    scene: &Scene,
+    face: Dir,
+    cell: &Aabb,
+    light: &Light,
+    blockers: &[TriId],
+    shaft: &Shaft,
+    tol: f32,
+    abs_scale: f32,
+) -> FaceRegions {
+    regions(scene, face, cell, light, blockers, shaft, (tol, abs_scale), false)
+}
+
+#[allow(clippy::too_many_arguments)]
+fn regions(
+    scene: &Scene,
+    face: Dir,
+    cell: &Aabb,
+    light: &Light,
+    blockers: &[TriId],
+    shaft: &Shaft,
+    (tol, abs_scale): (f32, f32),
+    penumbra: bool,
+) -> FaceRegions {
     let frame = FaceFrame::new(face, cell);
     let lv: Vec<(DVec3, f64)> = light.vertices.iter().map(|v| (v.as_dvec3(), frame.height(v.as_dvec3()))).collect();
     let min_h = lv.iter().map(|p| p.1).fold(f64::INFINITY, f64::min);
@@ -290,7 +321,7 @@ pub fn face_regions(
         if let Some(u) = s.umbra_of(&tri, &mut sc) {
             add(u, &mut umbra, &mut core);
         }
-        if !shadow.full() {
+        if penumbra && !shadow.full() {
             match s.shadow_of(&tri, &mut sc) {
                 Shadow::None => {}
                 Shadow::Whole => shadow.mark_all(),
@@ -340,7 +371,7 @@ pub fn face_regions(
             return out;
         }
     }
-    let shadow_shapes = difference(&shadow.rectangles(margin), &union(core));
+    let shadow_shapes = if penumbra { difference(&shadow.rectangles(margin), &union(core)) } else { Vec::new() };
     let face_area = UNITS * UNITS;
     out.umbra_fraction = (area(&out.umbra_shapes) / face_area).min(1.0);
     out.penumbra_fraction = (area(&shadow_shapes) / face_area).min(1.0);

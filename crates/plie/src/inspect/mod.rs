@@ -223,12 +223,18 @@ impl<'a> Inspector<'a> {
             FaceStatus::CannotSeeLight => return view,
             FaceStatus::Removed => {
                 let mut scratch = GatherScratch::new(self.scene.triangles.len());
-                gather_blockers(self.scene, self.octree, &shaft, light, &mut scratch, &mut view.blockers);
+                gather_blockers(self.scene, self.octree, &shaft, light, None, &mut scratch, &mut view.blockers);
                 view.umbra = vec![[corners[0], corners[1], corners[2]], [corners[0], corners[2], corners[3]]];
                 view.umbra_fraction = 1.0;
             }
             FaceStatus::Record(r) => {
                 view.blockers = self.plie.blockers_of(&self.plie.records[r]).to_vec();
+                if self.plie.records[r].kind == crate::lie::RecordKind::Scene {
+                    // It stores no list (answered by the scene BVH): gather them as the builder would
+                    // without a cap.
+                    let mut scratch = GatherScratch::new(self.scene.triangles.len());
+                    gather_blockers(self.scene, self.octree, &shaft, light, None, &mut scratch, &mut view.blockers);
+                }
                 let frame = FaceFrame::new(face, &bounds);
                 view.umbra = world_triangles(&frame, face, self.plie.umbra_of(r));
                 view.penumbra = world_triangles(&frame, face, self.plie.penumbra_of(r));

@@ -25,14 +25,14 @@ use xxhash_rust::xxh3::{xxh3_64, Xxh3};
 
 use super::atomic::write_atomic;
 use crate::error::{Error, Result};
-use crate::lie::{Plie, PlieParams, NO_RECORD, UMBRA_CELL};
+use crate::lie::{Plie, PlieParams, RecordKind, NO_RECORD, SCENE_CELL, UMBRA_CELL};
 use crate::octree::Octree;
 use crate::scene::Scene;
 
 /// First bytes of every `.plie` file.
 pub const MAGIC: [u8; 8] = *b"PLIE\r\n\x1a\n";
 /// Version of the layout written by this build of plie.
-pub const FORMAT_VERSION: u32 = 4;
+pub const FORMAT_VERSION: u32 = 5;
 const HEADER: usize = 8 + 4 + 8 + 8;
 
 /// What a `.plie` file holds after its header.
@@ -208,7 +208,13 @@ fn check_structure(p: &Plie, scene: &Scene, octree: &Octree) -> std::result::Res
             return Err(format!("record {i}: face grid out of bounds"));
         }
     }
-    if p.cells.iter().any(|&c| c != UMBRA_CELL && c.0 as u64 + c.1 as u64 > p.cell_blockers.len() as u64) {
+    if p.records.iter().any(|r| r.kind == RecordKind::Scene && r.blockers_len != 0) {
+        return Err("a record answered by the scene holds blockers".into());
+    }
+    if p.cells
+        .iter()
+        .any(|&c| c != UMBRA_CELL && c != SCENE_CELL && c.0 as u64 + c.1 as u64 > p.cell_blockers.len() as u64)
+    {
         return Err("grid cell list out of bounds".into());
     }
     if p.regions.len() != p.records.len() {

@@ -7,6 +7,12 @@
 //! the records: their umbra/penumbra triangles (§4.5, in the face's integer units, see
 //! [`crate::construct::regions::FaceFrame`]) and their face grids. Long blocker lists are stored in
 //! Morton order ([`CHUNKED_MIN`]).
+//!
+//! Bounded storage (issue 15): a record whose shaft holds more than [`PlieParams::blocker_cap`]
+//! blockers, or that would exceed the construction's memory budget, stores no list
+//! ([`RecordKind::Scene`]): shadow rays through its face are answered by the scene BVH, which is exact.
+//! Its umbra, computed from a subset of its blockers, is a subset of the true umbra and still answers
+//! "occluded"; its penumbra and its lit cells are unknown, so it stores none.
 
 use serde::{Deserialize, Serialize};
 
@@ -22,6 +28,11 @@ pub const CHUNKED_MIN: usize = 4 * CHUNK;
 /// Triangles per chunk when a shadow ray walks a long list: it tests a box around each chunk (and
 /// around each group of `CHUNK` chunks) first ([`crate::visibility::lie`]).
 pub const CHUNK: usize = 8;
+
+/// The cap `plie build`, `render`, `inspect` and `bench` use unless told otherwise
+/// ([`PlieParams::blocker_cap`]); chosen by the measurements of issue 15 in docs/results.md (64 built
+/// fastest and smallest of 64, 256 and 1024 on every larger scene, without slowing `grid` shading).
+pub const DEFAULT_BLOCKER_CAP: u32 = 64;
 
 /// `record_index` entry for "no data object".
 pub const NO_RECORD: u32 = u32::MAX;
@@ -45,6 +56,11 @@ pub struct PlieParams {
     /// Refinement of the octree after the records are known (SPEC §4.8); off by default, as in the
     /// thesis' test 1.
     pub refine: RefineParams,
+    /// Most blockers a record stores (issue 15): a record with more becomes [`RecordKind::Scene`],
+    /// and gathering its blockers stops there, so construction time and storage per record are
+    /// bounded. `None`: no cap (every record lists all its blockers, as in the thesis; the library's
+    /// [`PlieParams::thesis`] and default). [`PlieParams::bounded`] sets [`DEFAULT_BLOCKER_CAP`].
+    pub blocker_cap: Option<u32>,
 }
 
 impl PlieParams {
@@ -60,7 +76,14 @@ impl PlieParams {
             regions: true,
             propagation: true,
             refine: RefineParams::none(),
+            blocker_cap: None,
         }
+    }
+
+    /// These parameters with the default blocker cap ([`DEFAULT_BLOCKER_CAP`], issue 15): what the
+    /// command-line tool builds unless told otherwise.
+    pub fn bounded(self) -> PlieParams {
+        PlieParams { blocker_cap: Some(DEFAULT_BLOCKER_CAP), ..self }
     }
 
     /// The octree part of the parameters.
@@ -76,6 +99,19 @@ impl Default for PlieParams {
     }
 }
 
+/// How a record answers the rays through its face beyond its umbra.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub enum RecordKind {
+    /// By its blocker list (and its face grid): the thesis' record.
+    #[default]
+    Listed,
+    /// By the scene BVH ([`crate::visibility::bvh`], exact): its shaft holds more than
+    /// [`PlieParams::blocker_cap`] blockers, or its list did not fit the memory budget. It stores no
+    /// blocker list and no penumbra; its umbra (from a subset of its blockers) and its grid's umbra
+    /// cells still answer "occluded".
+    Scene,
+}
+
 /// One data object: a (leaf, face, light) and its blockers.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 pub struct Record {
@@ -89,6 +125,8 @@ pub struct Record {
     pub blockers_start: u32,
     /// Length of the blocker list.
     pub blockers_len: u32,
+    /// Whether the list holds every blocker ([`RecordKind::Listed`]) or none ([`RecordKind::Scene`]).
+    pub kind: RecordKind,
 }
 
 /// A record's umbra and penumbra triangles: ranges into [`Plie::region_tris`].
@@ -107,11 +145,16 @@ pub struct RecordRegions {
 /// `(start, len)` of a grid cell fully in umbra (no blocker list needed).
 pub const UMBRA_CELL: (u32, u32) = (u32::MAX, u32::MAX);
 
+/// `(start, len)` of a grid cell of a [`RecordKind::Scene`] record outside its umbra.
+pub const SCENE_CELL: (u32, u32) = (u32::MAX, u32::MAX - 1);
+
 /// What a face-grid cell says about rays crossing the face inside it.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Cell<'a> {
     /// Fully in umbra: every ray through it is blocked.
     Umbra,
+    /// Its record stores no list ([`RecordKind::Scene`]): ask the scene BVH.
+    Scene,
     /// Test these blockers (none: fully lit by the blockers).
     Blockers(&'a [TriId]),
 }
@@ -190,6 +233,7 @@ impl Plie {
     pub fn cell(&self, grid: &FaceGrid, c: usize) -> Cell<'_> {
         match self.cells[grid.cells_start as usize + c] {
             UMBRA_CELL => Cell::Umbra,
+            SCENE_CELL => Cell::Scene,
             (s, n) => Cell::Blockers(&self.cell_blockers[s as usize..(s + n) as usize]),
         }
     }
@@ -218,6 +262,11 @@ impl Plie {
             + self.cell_blockers.len() * std::mem::size_of::<TriId>()
             + self.regions.len() * std::mem::size_of::<RecordRegions>()
             + self.region_tris.len() * std::mem::size_of::<Tri2>()
+    }
+
+    /// Records answered by the scene BVH ([`RecordKind::Scene`]).
+    pub fn scene_records(&self) -> usize {
+        self.records.iter().filter(|r| r.kind == RecordKind::Scene).count()
     }
 
     /// Mean and maximum blockers per record.

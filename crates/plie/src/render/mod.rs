@@ -26,6 +26,11 @@ pub trait Progress: Sync {
     fn advance(&self, _n: u64) {}
     /// The stage is done.
     fn finish(&self) {}
+    /// The user asked to stop (Ctrl-C): long work that can be interrupted returns early with
+    /// an error (the P-LIE construction: [`crate::construct::Interrupted`]).
+    fn cancelled(&self) -> bool {
+        false
+    }
 }
 
 /// Progress that goes nowhere.

@@ -26,11 +26,15 @@ pub enum Answer {
     InsideLeaf,
     /// The start point lies in no leaf: answered by walking the octree (mode a), either way.
     OutsideOctree,
+    /// The segment leaves its leaf through a face whose record stores no list
+    /// ([`crate::lie::RecordKind::Scene`]: more blockers than the cap, or over the memory budget), and
+    /// not inside its umbra: the whole segment answered by the scene BVH, either way.
+    SceneBvh,
 }
 
 impl Answer {
     /// Every path, in the order `--stats` prints them.
-    pub const ALL: [Answer; 8] = [
+    pub const ALL: [Answer; 9] = [
         Answer::NoRecord,
         Answer::Umbra,
         Answer::Lit,
@@ -39,6 +43,7 @@ impl Answer {
         Answer::OwnLeaf,
         Answer::InsideLeaf,
         Answer::OutsideOctree,
+        Answer::SceneBvh,
     ];
 
     /// The name of the path: its [`Answers`] field and JSON key.
@@ -52,6 +57,7 @@ impl Answer {
             Answer::OwnLeaf => "own_leaf",
             Answer::InsideLeaf => "inside_leaf",
             Answer::OutsideOctree => "outside_octree",
+            Answer::SceneBvh => "scene_bvh",
         }
     }
 
@@ -60,7 +66,7 @@ impl Answer {
         match self {
             Answer::NoRecord | Answer::Umbra | Answer::BlockersHit | Answer::OwnLeaf => Some(true),
             Answer::Lit | Answer::BlockersMiss | Answer::InsideLeaf => Some(false),
-            Answer::OutsideOctree => None,
+            Answer::OutsideOctree | Answer::SceneBvh => None,
         }
     }
 }
@@ -84,6 +90,8 @@ pub struct Answers {
     pub inside_leaf: u64,
     /// See [`Answer::OutsideOctree`].
     pub outside_octree: u64,
+    /// See [`Answer::SceneBvh`].
+    pub scene_bvh: u64,
 }
 
 impl Answers {
@@ -99,6 +107,7 @@ impl Answers {
             Answer::OwnLeaf => &mut self.own_leaf,
             Answer::InsideLeaf => &mut self.inside_leaf,
             Answer::OutsideOctree => &mut self.outside_octree,
+            Answer::SceneBvh => &mut self.scene_bvh,
         }
     }
 
@@ -148,6 +157,6 @@ mod tests {
         let mut b = a;
         b += a;
         assert_eq!(b.total(), 2 * a.total());
-        assert_eq!(a.total(), 36);
+        assert_eq!(a.total(), 45);
     }
 }

@@ -119,21 +119,27 @@ impl<'a> BvhVisibility<'a> {
 
 impl Visibility for BvhVisibility<'_> {
     fn occluded(&self, ray: &ShadowRay, ctx: &mut QueryCtx) -> bool {
-        let bvh = self.bvh;
-        let dir = Vec3A::from(ray.test.dir * (bvh.scale / SEGMENT_T));
-        let r = Ray::new(bvh.to_local(ray.test.origin), dir, 0.0, SEGMENT_T * (1.0 + 1e-6));
-        let mut state = bvh.cw.new_traversal(r.direction);
-        let mut node;
-        let mut hit = false;
-        'outer: {
-            obvhs::traverse!(bvh.cw, node, state, node.intersect_ray(&r, state.oct_inv4), {
-                let tri = TriId(bvh.cw.primitive_indices[state.primitive_id as usize]);
-                if blocks(self.scene, ray, tri, ctx) {
-                    hit = true;
-                    break 'outer;
-                }
-            });
-        }
-        hit
+        segment_occluded(self.scene, self.bvh, ray, ctx)
     }
+}
+
+/// Whether a triangle of `scene` blocks the whole shadow ray `ray`, found by traversing `bvh` and
+/// deciding candidates with the shared [`blocks`] predicate: brute force's answer. The `bvh` mode, and
+/// the P-LIE modes for records that store no list ([`crate::lie::RecordKind::Scene`]), use it.
+pub(crate) fn segment_occluded(scene: &Scene, bvh: &Bvh, ray: &ShadowRay, ctx: &mut QueryCtx) -> bool {
+    let dir = Vec3A::from(ray.test.dir * (bvh.scale / SEGMENT_T));
+    let r = Ray::new(bvh.to_local(ray.test.origin), dir, 0.0, SEGMENT_T * (1.0 + 1e-6));
+    let mut state = bvh.cw.new_traversal(r.direction);
+    let mut node;
+    let mut hit = false;
+    'outer: {
+        obvhs::traverse!(bvh.cw, node, state, node.intersect_ray(&r, state.oct_inv4), {
+            let tri = TriId(bvh.cw.primitive_indices[state.primitive_id as usize]);
+            if blocks(scene, ray, tri, ctx) {
+                hit = true;
+                break 'outer;
+            }
+        });
+    }
+    hit
 }

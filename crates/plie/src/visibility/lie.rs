@@ -8,6 +8,9 @@
 //! - `penumbra` (d): as (c), and `f` outside both umbra and penumbra: no blocker can hit, skip them;
 //! - `grid`: the face-grid cell of `f` says umbra (occluded) or which blockers to test.
 //!
+//! A record that stores no list ([`RecordKind::Scene`], issue 15) answers a ray outside its umbra (or
+//! its grid's umbra cells) by the scene BVH, for the whole segment ([`Answer::SceneBvh`]).
+//!
 //! Then the triangles of `c` itself (the part of the segment inside `c`). A segment that never leaves
 //! `c` only needs `c`'s triangles. Regions are conservative (see [`crate::construct::regions`]), so
 //! every mode answers exactly as the blocker test would.
@@ -15,6 +18,7 @@
 //! Each ray is counted on the [`Answer`] path that decided it, and its triangle tests are split into
 //! blocker tests and own-leaf tests (`plie render --stats`).
 
+use super::bvh::{segment_occluded, Bvh};
 use super::fan::Fan;
 use super::leaf_voxels::LeafVoxels;
 use super::query::SEGMENT_EPS;
@@ -22,7 +26,7 @@ use super::{blocks, Answer, LightRays, Mode, OctreeVisibility, QueryCtx, ShadowR
 use crate::construct::grid;
 use crate::construct::regions::{in_triangles, FaceFrame};
 use crate::geometry::{Aabb, Segment};
-use crate::lie::{Cell, Plie, CHUNK, CHUNKED_MIN};
+use crate::lie::{Cell, Plie, RecordKind, CHUNK, CHUNKED_MIN};
 use crate::octree::{Dir, LeafId, Octree};
 use crate::scene::{Scene, TriId};
 
@@ -107,6 +111,8 @@ pub struct LieVisibility<'a> {
     scene: &'a Scene,
     octree: &'a Octree,
     plie: &'a Plie,
+    /// The scene BVH, for the records that store no list.
+    bvh: &'a Bvh,
     /// Grown bounding box of every triangle.
     tri_boxes: Vec<Aabb>,
     /// `Lie`, `Umbra`, `Penumbra` or `Grid`.
@@ -130,7 +136,7 @@ impl<'a> LieVisibility<'a> {
     /// Mode `mode` (one of `Lie`, `Umbra`, `Penumbra`, `Grid`; others answer as `Lie`) over a P-LIE
     /// built for `scene` and `octree`. Without regions or grids in the P-LIE, the modes that use them
     /// test the blockers instead (still exact).
-    pub fn new(scene: &'a Scene, octree: &'a Octree, plie: &'a Plie, mode: Mode) -> LieVisibility<'a> {
+    pub fn new(scene: &'a Scene, bvh: &'a Bvh, octree: &'a Octree, plie: &'a Plie, mode: Mode) -> LieVisibility<'a> {
         let pad = scene.scale() * crate::construct::TOLERANCE_REL;
         let tri_boxes: Vec<Aabb> = scene.triangles.iter().map(|t| t.aabb().expanded(pad)).collect();
         let voxels = LeafVoxels::new(octree, &tri_boxes, pad);
@@ -154,6 +160,7 @@ impl<'a> LieVisibility<'a> {
             scene,
             octree,
             plie,
+            bvh,
             tri_boxes,
             voxels,
             mode,
@@ -249,17 +256,21 @@ impl Visibility for LieVisibility<'_> {
                     return ctx.stats.answered(Answer::NoRecord, true);
                 };
                 let f = ray.test.origin + ray.test.dir * t_exit;
+                let scene_record = self.plie.records[ri].kind == RecordKind::Scene;
                 let record = || self.record_boxes.of(ri, self.plie.blockers_of(&self.plie.records[ri]));
+                // `None`: the record stores no list; the scene answers.
                 let list = match self.mode {
                     Mode::Umbra | Mode::Penumbra => {
                         let x = FaceFrame::new(face, &self.octree.leaf_bounds(leaf)).units(f.as_dvec3());
                         if in_triangles(self.plie.umbra_of(ri), x) {
                             return ctx.stats.answered(Answer::Umbra, true);
                         }
-                        if self.mode == Mode::Penumbra && !in_triangles(self.plie.penumbra_of(ri), x) {
-                            Chunked::EMPTY
+                        if scene_record {
+                            None
+                        } else if self.mode == Mode::Penumbra && !in_triangles(self.plie.penumbra_of(ri), x) {
+                            Some(Chunked::EMPTY)
                         } else {
-                            record()
+                            Some(record())
                         }
                     }
                     Mode::Grid if self.plie.grids[ri].res > 0 => {
@@ -267,10 +278,18 @@ impl Visibility for LieVisibility<'_> {
                         let c = grid::cell_of(face, &self.octree.leaf_bounds(leaf), grid.res, f);
                         match self.plie.cell(grid, c) {
                             Cell::Umbra => return ctx.stats.answered(Answer::Umbra, true),
-                            Cell::Blockers(list) => self.cell_boxes.of(grid.cells_start as usize + c, list),
+                            Cell::Scene => None,
+                            Cell::Blockers(list) => Some(self.cell_boxes.of(grid.cells_start as usize + c, list)),
                         }
                     }
-                    _ => record(),
+                    _ => (!scene_record).then(record),
+                };
+                let Some(list) = list else {
+                    // The whole segment, by the scene BVH; its triangle tests count as blocker tests.
+                    let before = ctx.stats.triangle_tests;
+                    let hit = segment_occluded(self.scene, self.bvh, ray, ctx);
+                    ctx.stats.blocker_tests += ctx.stats.triangle_tests - before;
+                    return ctx.stats.answered(Answer::SceneBvh, hit);
                 };
                 if list.list.is_empty() {
                     Answer::Lit
@@ -342,6 +361,8 @@ impl Visibility for LieVisibility<'_> {
                 continue;
             };
             let f = x + d * t_exit;
+            let scene_record = self.plie.records[ri].kind == RecordKind::Scene;
+            // `Some(None)`: no list to test (lit); `None`: the record stores no list, the scene answers.
             let key = match self.mode {
                 Mode::Umbra | Mode::Penumbra => {
                     let p = FaceFrame::new(face, &bounds).units(f.as_dvec3());
@@ -350,27 +371,39 @@ impl Visibility for LieVisibility<'_> {
                         sc.path[k] = path::DONE;
                         continue;
                     }
-                    if self.mode == Mode::Penumbra && !in_triangles(self.plie.penumbra_of(ri), p) {
+                    if scene_record {
                         None
+                    } else if self.mode == Mode::Penumbra && !in_triangles(self.plie.penumbra_of(ri), p) {
+                        Some(None)
                     } else {
-                        Some(ri as u32)
+                        Some(Some(ri as u32))
                     }
                 }
                 Mode::Grid if self.plie.grids[ri].res > 0 => {
                     let grid = &self.plie.grids[ri];
                     let c = grid::cell_of(face, &bounds, grid.res, f);
-                    let ci = grid.cells_start as usize + c;
-                    match self.plie.cells[ci] {
-                        crate::lie::UMBRA_CELL => {
+                    match self.plie.cell(grid, c) {
+                        Cell::Umbra => {
                             out[k] = ctx.stats.answered(Answer::Umbra, true);
                             sc.path[k] = path::DONE;
                             continue;
                         }
-                        (_, 0) => None,
-                        _ => Some(ci as u32 | CELL_KEY),
+                        Cell::Scene => None,
+                        Cell::Blockers([]) => Some(None),
+                        Cell::Blockers(_) => Some(Some((grid.cells_start as usize + c) as u32 | CELL_KEY)),
                     }
                 }
-                _ => Some(ri as u32).filter(|_| self.plie.records[ri].blockers_len > 0),
+                _ if scene_record => None,
+                _ => Some(Some(ri as u32).filter(|_| self.plie.records[ri].blockers_len > 0)),
+            };
+            let Some(key) = key else {
+                // The whole segment, by the scene BVH, as `occluded` does.
+                let before = ctx.stats.triangle_tests;
+                let hit = segment_occluded(self.scene, self.bvh, &rays.ray(k), ctx);
+                ctx.stats.blocker_tests += ctx.stats.triangle_tests - before;
+                out[k] = ctx.stats.answered(Answer::SceneBvh, hit);
+                sc.path[k] = path::DONE;
+                continue;
             };
             if let Some(key) = key {
                 sc.path[k] = path::LIST;
@@ -387,7 +420,11 @@ impl Visibility for LieVisibility<'_> {
         let open = sc.path.iter().filter(|&&p| p != path::DONE).count();
         ctx.stats.lights.queries += 1;
         if open == 0 {
-            ctx.stats.lights.whole_umbra += 1;
+            if out.iter().all(|&o| o) {
+                ctx.stats.lights.whole_umbra += 1;
+            } else {
+                ctx.stats.lights.per_sample += 1;
+            }
         } else {
             let lanes_before = ctx.stats.lane_tests;
             let margin = self.pad * 10.0;
@@ -566,7 +603,8 @@ mod tests {
         let params = PlieParams { grids: true, ..PlieParams::thesis() };
         let octree = Octree::build(&scene, params.octree());
         let (plie, _) = build(&scene, &octree, params, &NoProgress);
-        let vis = LieVisibility::new(&scene, &octree, &plie, Mode::Grid);
+        let bvh = crate::visibility::bvh::Bvh::build(&scene);
+        let vis = LieVisibility::new(&scene, &bvh, &octree, &plie, Mode::Grid);
         let inside = |a: &Aabb, b: &Aabb| b.min.cmple(a.min).all() && a.max.cmple(b.max).all();
         let (mut long, mut volume_sorted, mut volume_ids) = (0, 0.0f64, 0.0f64);
         for (ri, r) in plie.records.iter().enumerate() {

@@ -97,7 +97,7 @@ pub fn for_mode<'a>(
                     "mode {mode} needs umbra and penumbra, but the P-LIE was built without them (--no-regions)"
                 )));
             }
-            Box::new(LieVisibility::new(scene, octree, plie, mode))
+            Box::new(LieVisibility::new(scene, bvh, octree, plie, mode))
         }
         #[cfg(feature = "embree")]
         Mode::Embree => Box::new(EmbreeVisibility::new(scene)?),

@@ -1,8 +1,10 @@
 //! The ten built-in test scenes of SPEC §6 (thesis chapter 7), generated in code (no files needed),
 //! deterministically and in a few milliseconds. One file per family: `cornell` (Cornell Cube 1-5,
 //! millimetres), `huis` (Huis A, B, C, metres), `dragon` (Cornell Cube 2 with a creature), `boot` (a
-//! boat on the water, metres); the mesh helpers they share are in `shapes`.
+//! boat on the water, metres); the mesh helpers they share are in `shapes`. Beside them, the stress
+//! scene `balusters` of issue 15 (not a thesis scene: [`STRESS`]).
 
+mod balusters;
 mod boot;
 mod chair;
 mod cornell;
@@ -43,8 +45,19 @@ pub fn description(name: &str) -> Option<&'static str> {
         "huis-c" => "huis-b with a second light, outside the camera's view",
         "dragon" => "cornell-cube-2 with a dragon on a block: cells crowd around the dragon",
         "boot" => "a boat on the water lit by one distant light: hardly any shadow",
+        "balusters" => "stress scene: a floor, 64 x 64 thin rods and a small ceiling light (balusters-N: N x N rods)",
+        n if balusters::rods_of(n).is_some() => "stress scene: the balusters at another size",
         _ => return None,
     })
+}
+
+/// The built-in stress scenes (issue 15): many thin rods between the floor and a small light.
+/// `balusters-N` (N from 1 to [`balusters::MAX_RODS`] rods per side) is the same scene at another size.
+pub const STRESS: [&str; 1] = ["balusters"];
+
+/// Whether `name` is a built-in scene (a thesis scene, a stress scene, or a sized stress scene).
+pub fn exists(name: &str) -> bool {
+    NAMES.contains(&name) || balusters::rods_of(name).is_some()
 }
 
 /// Builds the built-in scene `name`; [`Error::UnknownScene`] if there is none by that name.
@@ -60,7 +73,15 @@ pub fn load(name: &str) -> Result<Scene> {
         "huis-c" => huis::huis_c()?,
         "dragon" => dragon::dragon()?,
         "boot" => boot::boot()?,
-        _ => return Err(Error::UnknownScene { name: name.to_string(), known: NAMES.join(", ") }),
+        _ if balusters::rods_of(name).is_some() => {
+            balusters::balusters(name, balusters::rods_of(name).expect("checked"))?
+        }
+        _ => {
+            return Err(Error::UnknownScene {
+                name: name.to_string(),
+                known: format!("{}, {} (or balusters-N)", NAMES.join(", "), STRESS.join(", ")),
+            })
+        }
     };
     builder.build()
 }
