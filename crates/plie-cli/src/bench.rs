@@ -205,7 +205,8 @@ pub fn run(a: &Args) -> Result<()> {
 
 /// Loads a built-in scene or a scene file, with its camera (or a framing default).
 fn load(name: &str) -> Result<(Scene, Camera)> {
-    let args = SceneArgs { scene: name.to_string(), eye: None, target: None, up: None, fov: None };
+    let args =
+        SceneArgs { scene: name.to_string(), eye: None, target: None, up: None, fov: None, allow_outside_paths: false };
     let scene = args.load()?;
     let camera = args.camera(&scene)?;
     Ok((scene, camera))

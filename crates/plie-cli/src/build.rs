@@ -35,6 +35,7 @@ pub struct Args {
 
 pub fn run(a: &Args) -> Result<()> {
     crate::scenes::set_threads(a.threads)?;
+    crate::checks::plie_output(&a.output, &a.scene.file().into_iter().collect::<Vec<_>>())?;
     let scene = a.scene.load()?;
     let params = a.params.params(true)?;
     let bar = Bar::new(a.quiet || a.json);

@@ -6,6 +6,7 @@ mod bench;
 mod bench_chart;
 mod bench_report;
 mod build;
+mod checks;
 mod image_args;
 mod inspect;
 mod plie_args;
@@ -13,6 +14,7 @@ mod progress;
 mod render;
 mod scene_arg;
 mod scenes;
+mod verify;
 
 use clap::{Parser, Subcommand};
 
@@ -34,21 +36,34 @@ enum Command {
     Build(Box<build::Args>),
     /// Show what the P-LIE stores for a cell: a picture, a glTF scene, or a per-leaf summary.
     Inspect(Box<inspect::Args>),
+    /// Check a P-LIE file against a rebuild: a sample of records by shadow rays, or all (--full).
+    Verify(Box<verify::Args>),
     /// Measure construction, shading and throughput per scene and mode (the thesis' protocol).
     Bench(Box<bench::Args>),
 }
 
 fn main() {
-    let cli = Cli::parse();
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        Err(e) if e.use_stderr() => {
+            // One line: clap's first paragraph (the problem), without the usage and tips that follow.
+            let text = e.render().to_string();
+            let first: Vec<&str> = text.lines().map(str::trim).take_while(|l| !l.is_empty()).collect();
+            eprintln!("{}", checks::shorten_long_words(&first.join(" ")));
+            std::process::exit(e.exit_code());
+        }
+        Err(e) => e.exit(),
+    };
     let result = match cli.command {
         Command::Scenes(a) => scenes::run(&a),
         Command::Render(a) => render::run(&a),
         Command::Build(a) => build::run(&a),
         Command::Inspect(a) => inspect::run(&a),
         Command::Bench(a) => bench::run(&a),
+        Command::Verify(a) => verify::run(&a),
     };
     if let Err(e) = result {
-        eprintln!("error: {}", one_line(&e));
+        eprintln!("error: {}", checks::shorten_long_words(&one_line(&e)));
         std::process::exit(1);
     }
 }

@@ -53,6 +53,9 @@ pub struct Args {
 
 pub fn run(a: &Args) -> Result<()> {
     crate::scenes::set_threads(a.threads)?;
+    plie::io::ImageFormat::from_path(&a.output)?;
+    let inputs: Vec<&std::path::Path> = a.scene.file().into_iter().chain(a.plie.as_deref()).collect();
+    crate::checks::output_is_not_input(&a.output, &inputs)?;
     let settings = a.image.settings()?;
     let t = Instant::now();
     let scene = a.scene.load()?;
@@ -61,7 +64,6 @@ pub fn run(a: &Args) -> Result<()> {
         eprintln!("warning: skipped {} degenerate (zero-area) triangles", scene.degenerate_skipped);
     }
     let camera = a.scene.camera(&scene)?;
-    plie::io::check_image_path(&a.output)?;
 
     let t = Instant::now();
     let bvh = Bvh::build(&scene);

@@ -23,8 +23,13 @@ pub struct SceneArgs {
     #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true)]
     pub up: Option<Vec3>,
     /// Vertical field of view in degrees.
-    #[arg(long, value_name = "DEG")]
+    #[arg(long, value_name = "DEG", allow_hyphen_values = true)]
     pub fov: Option<f32>,
+    /// Let the scene file name files outside its own folder (absolute paths, `..`, `file:` URIs in
+    /// `mtllib` lines or glTF buffer URIs). Off by default: a scene from elsewhere cannot make plie
+    /// read other files.
+    #[arg(long)]
+    pub allow_outside_paths: bool,
 }
 
 impl SceneArgs {
@@ -40,7 +45,14 @@ impl SceneArgs {
             }
             bail!("{}: no such file", path.display());
         }
-        plie::io::load_scene(path).with_context(|| format!("cannot load scene {}", path.display()))
+        let opts = plie::io::LoadOptions { allow_outside_paths: self.allow_outside_paths };
+        plie::io::load_scene_with(path, opts).with_context(|| format!("cannot load scene {}", path.display()))
+    }
+
+    /// The scene file, when the scene is a file (an output must never overwrite it).
+    pub fn file(&self) -> Option<&Path> {
+        let builtin = builtin::NAMES.contains(&self.scene.as_str());
+        (!builtin).then(|| Path::new(&self.scene))
     }
 
     /// The camera: the scene's (or a framing default), with any option given overriding a part.
