@@ -265,7 +265,7 @@ fn run_path(a: &Args, plan: Plan) -> Result<()> {
 
 /// Loads a built-in scene or a scene file, with its camera (or a framing default).
 fn load(name: &str) -> Result<(Scene, Camera)> {
-    let args = SceneArgs { scene: name.to_string() };
+    let args = SceneArgs { scene: name.to_string(), allow_outside_paths: false };
     let scene = args.load()?;
     let camera = scene.camera_or_default();
     Ok((scene, camera))

@@ -72,7 +72,7 @@ pub fn run(plan: &PathPlan, out: &Path, bar: &Bar) -> Result<()> {
     let mut rows = Vec::new();
     for name in &plan.scenes {
         let (eye, target, fov) = camera_for(name);
-        let args = SceneArgs { scene: name.clone() };
+        let args = SceneArgs { scene: name.clone(), allow_outside_paths: false };
         let scene = args.load().with_context(|| format!("scene {name}"))?;
         let camera: Camera = CameraArgs { eye, target, up: None, fov }.camera(&scene)?;
         let bvh = Bvh::build(&scene);

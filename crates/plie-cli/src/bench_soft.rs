@@ -114,7 +114,7 @@ pub fn default_scenes(shared: &Path) -> Vec<String> {
 
 /// Loads a scene with the table's camera: the README's for the shared files, else the scene's own.
 fn load(name: &str) -> Result<(Scene, Camera)> {
-    let args = crate::scene_arg::SceneArgs { scene: name.to_string() };
+    let args = crate::scene_arg::SceneArgs { scene: name.to_string(), allow_outside_paths: false };
     let scene = args.load()?;
     let file = Path::new(name).file_name().and_then(|f| f.to_str()).unwrap_or("");
     let camera = match SHARED.iter().find(|(f, ..)| *f == file) {

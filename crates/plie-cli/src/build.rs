@@ -42,6 +42,7 @@ pub fn run(a: &Args) -> Result<()> {
     // First, so that Ctrl-C at any point before the file is written stops the build cleanly.
     crate::progress::install_interrupt()?;
     crate::scenes::set_threads(a.threads)?;
+    crate::checks::plie_output(&a.output, &a.scene.file().into_iter().collect::<Vec<_>>())?;
     let scene = a.scene.load()?;
     if !a.quiet {
         crate::scene_arg::warn_about(&scene);

@@ -7,11 +7,11 @@ use plie::render::RenderSettings;
 /// Options that set the rendered image.
 #[derive(clap::Args, Clone, Debug)]
 pub struct ImageArgs {
-    /// Image width in pixels.
-    #[arg(long, default_value_t = 398)]
+    /// Image width in pixels (1 to 32768).
+    #[arg(long, default_value_t = 398, value_parser = clap::value_parser!(u32).range(1..=32768))]
     pub width: u32,
-    /// Image height in pixels.
-    #[arg(long, default_value_t = 398)]
+    /// Image height in pixels (1 to 32768).
+    #[arg(long, default_value_t = 398, value_parser = clap::value_parser!(u32).range(1..=32768))]
     pub height: u32,
     /// K: K x K regular eye rays per pixel.
     #[arg(long, default_value_t = 2, value_name = "K")]

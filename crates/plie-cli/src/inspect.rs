@@ -86,10 +86,6 @@ fn output_kind(path: &Path) -> Result<Output> {
         _ if GltfFormat::from_path(path).is_some() => Output::Gltf,
         _ => bail!("{}: unknown output format '.{ext}'; plie inspect writes .png, .gltf or .glb", path.display()),
     };
-    let dir = path.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(Path::new("."));
-    if !dir.is_dir() {
-        bail!("{}: the directory '{}' does not exist", path.display(), dir.display());
-    }
     Ok(kind)
 }
 
@@ -102,6 +98,10 @@ pub fn run(a: &Args) -> Result<()> {
         bail!("-o needs --cell X,Y,Z: a point in the octree leaf to show");
     }
     let kind = a.output.as_deref().map(output_kind).transpose()?;
+    if let Some(out) = &a.output {
+        let inputs: Vec<&Path> = a.scene.file().into_iter().chain(a.plie.as_deref()).collect();
+        crate::checks::output_is_not_input(out, &inputs)?;
+    }
     let face: Option<Dir> = a.face.as_deref().map(str::parse).transpose().map_err(anyhow::Error::msg)?;
     let settings = a.image.settings()?;
     if !(a.line_width.is_finite() && a.line_width > 0.0) {

@@ -9,6 +9,7 @@ mod bench_report;
 mod bench_soft;
 mod budget;
 mod build;
+mod checks;
 mod image_args;
 mod inspect;
 mod path_args;
@@ -18,6 +19,7 @@ mod render;
 mod render_path;
 mod scene_arg;
 mod scenes;
+mod verify;
 
 use clap::{Parser, Subcommand};
 
@@ -40,21 +42,34 @@ enum Command {
     Build(Box<build::Args>),
     /// Show what the P-LIE stores for a cell: a picture, a glTF scene, or a per-leaf summary.
     Inspect(Box<inspect::Args>),
+    /// Check a P-LIE file against a rebuild: a sample of records by shadow rays, or all (--full).
+    Verify(Box<verify::Args>),
     /// Measure P-LIE build, shading and shadow-ray throughput per scene and mode, and write a report.
     Bench(Box<bench::Args>),
 }
 
 fn main() {
-    let cli = Cli::parse();
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        Err(e) if e.use_stderr() => {
+            // One line: clap's first paragraph (the problem), without the usage and tips that follow.
+            let text = e.render().to_string();
+            let first: Vec<&str> = text.lines().map(str::trim).take_while(|l| !l.is_empty()).collect();
+            eprintln!("{}", checks::shorten_long_words(&first.join(" ")));
+            std::process::exit(e.exit_code());
+        }
+        Err(e) => e.exit(),
+    };
     let result = match cli.command {
         Command::Scenes(a) => scenes::run(&a),
         Command::Render(a) => render::run(&a),
         Command::Build(a) => build::run(&a),
         Command::Inspect(a) => inspect::run(&a),
         Command::Bench(a) => bench::run(&a),
+        Command::Verify(a) => verify::run(&a),
     };
     if let Err(e) = result {
-        eprintln!("error: {}", one_line(&e));
+        eprintln!("error: {}", checks::shorten_long_words(&one_line(&e)));
         std::process::exit(1);
     }
 }

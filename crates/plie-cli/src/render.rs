@@ -67,6 +67,9 @@ pub struct Args {
 
 pub fn run(a: &Args) -> Result<()> {
     crate::scenes::set_threads(a.threads)?;
+    plie::io::ImageFormat::from_path(&a.output)?;
+    let inputs: Vec<&std::path::Path> = a.scene.file().into_iter().chain(a.plie.as_deref()).collect();
+    crate::checks::output_is_not_input(&a.output, &inputs)?;
     let mut settings = a.image.settings()?;
     if a.path.integrator == Integrator::Direct {
         settings.eye_rays = a.path.eye_rays(settings.eye_rays)?;
@@ -81,7 +84,6 @@ pub fn run(a: &Args) -> Result<()> {
         crate::scene_arg::warn_about(&scene);
     }
     let camera = a.camera.camera(&scene)?;
-    plie::io::check_image_path(&a.output)?;
 
     let t = Instant::now();
     let bvh = Bvh::build(&scene);

@@ -14,6 +14,11 @@ pub struct SceneArgs {
     /// A built-in scene name (see `plie scenes`) or a scene file (.obj with its .mtl, .gltf, .glb).
     #[arg(long, value_name = "NAME|FILE")]
     pub scene: String,
+    /// Let the scene file name files outside its own folder (absolute paths, `..`, `file:` URIs in
+    /// `mtllib` lines or glTF buffer URIs). Off by default: a scene from elsewhere cannot make plie
+    /// read other files.
+    #[arg(long)]
+    pub allow_outside_paths: bool,
 }
 
 /// Options that set the camera (subcommands that render a picture).
@@ -29,7 +34,7 @@ pub struct CameraArgs {
     #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true)]
     pub up: Option<Vec3>,
     /// Vertical field of view in degrees.
-    #[arg(long, value_name = "DEG")]
+    #[arg(long, value_name = "DEG", allow_hyphen_values = true)]
     pub fov: Option<f32>,
 }
 
@@ -46,7 +51,14 @@ impl SceneArgs {
             }
             bail!("{}: no such file", path.display());
         }
-        plie::io::load_scene(path).with_context(|| format!("cannot load scene {}", path.display()))
+        let opts = plie::io::LoadOptions { allow_outside_paths: self.allow_outside_paths };
+        plie::io::load_scene_with(path, opts).with_context(|| format!("cannot load scene {}", path.display()))
+    }
+
+    /// The scene file, when the scene is a file (an output must never overwrite it).
+    pub fn file(&self) -> Option<&Path> {
+        let builtin = builtin::exists(&self.scene);
+        (!builtin).then(|| Path::new(&self.scene))
     }
 }
 

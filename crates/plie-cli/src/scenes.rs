@@ -43,13 +43,7 @@ pub fn count(n: usize, noun: &str) -> String {
     }
 }
 
-/// Sets the global rayon pool size (`--threads`).
+/// Sets the global rayon pool size (`--threads`), bounded ([`crate::checks::set_threads`]).
 pub fn set_threads(threads: Option<usize>) -> Result<()> {
-    if let Some(t) = threads {
-        if t == 0 {
-            anyhow::bail!("--threads must be at least 1");
-        }
-        rayon::ThreadPoolBuilder::new().num_threads(t).build_global()?;
-    }
-    Ok(())
+    crate::checks::set_threads(threads)
 }

@@ -342,7 +342,7 @@ fn unknown_scene_and_bad_output_give_one_line_errors() {
         &["render", "--scene", "cornell-cube-1", "-o", bad.to_str().unwrap(), "--width", "8", "--height", "8"],
         "out.bmp",
     );
-    fails_with(&["render", "--scene", "cornell-cube-1", "-o", "/tmp/x.png", "--width", "0"], "size");
+    fails_with(&["render", "--scene", "cornell-cube-1", "-o", "/tmp/x.png", "--width", "0"], "32768");
     fails_with(&["render", "--scene", "cornell-cube-1", "-o", "/tmp/x.png", "--fov", "200"], "field of view");
 }
 

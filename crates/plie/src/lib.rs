@@ -46,4 +46,5 @@ pub mod inspect;
 pub mod lie;
 pub mod octree;
 pub mod render;
+pub mod verify;
 pub mod visibility;

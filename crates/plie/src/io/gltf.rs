@@ -23,21 +23,30 @@ use ::gltf::mesh::Mode;
 use ::gltf::{Accessor, Document, Semantic};
 use glam::{Mat4, Vec3};
 
+use super::input::{read_bounded, resolve_in_scene, short, LoadOptions, MAX_INPUT_BYTES};
 use super::lights::{self, EmissiveTriangle};
 use super::{material_warnings, parse_error, scene_name};
 use crate::error::{Error, Result};
 use crate::scene::{Camera, Material, MaterialId, Scene, SceneBuilder};
 
-/// Loads a `.gltf` or `.glb` file (see the module doc).
+/// Loads a `.gltf` or `.glb` file (see the module doc); buffers only from the file's folder.
 pub fn load_gltf(path: &Path) -> Result<Scene> {
+    load_gltf_with(path, LoadOptions::default())
+}
+
+/// [`load_gltf`] with options.
+pub fn load_gltf_with(path: &Path, opts: LoadOptions) -> Result<Scene> {
     let bad = |m: String| parse_error(path, None, m);
-    let bytes = std::fs::read(path).map_err(|source| Error::Io { path: path.to_path_buf(), source })?;
+    let bytes = read_bounded(path, MAX_INPUT_BYTES)?;
     if bytes.is_empty() {
         return Err(bad("the file is empty".into()));
     }
     check_glb_header(&bytes).map_err(bad)?;
-    let gltf = ::gltf::Gltf::from_slice(&bytes).map_err(|e| gltf_error(path, e))?;
-    let buffers = load_buffers(path, &gltf.document, gltf.blob.clone())?;
+    let raw = ::gltf::Gltf::from_slice_without_validation(&bytes).map_err(|e| gltf_error(path, e))?;
+    check_primitive_indices(raw.document.as_json()).map_err(bad)?;
+    let document = ::gltf::Document::from_json(raw.document.into_json()).map_err(|e| gltf_error(path, e))?;
+    let gltf = ::gltf::Gltf { document, blob: raw.blob };
+    let buffers = load_buffers(path, &gltf.document, gltf.blob.clone(), opts)?;
     let doc = &gltf.document;
     let scene =
         doc.default_scene().or_else(|| doc.scenes().next()).ok_or_else(|| bad("the file has no scene".into()))?;
@@ -94,6 +103,34 @@ fn gltf_error(path: &Path, e: ::gltf::Error) -> Error {
     }
 }
 
+/// The `gltf` crate's validation indexes the accessors of every primitive's `POSITION` unchecked (an
+/// index-out-of-bounds panic in `gltf-json`): check every accessor index of a primitive first.
+fn check_primitive_indices(root: &::gltf::json::Root) -> Result<(), String> {
+    let n = root.accessors.len();
+    for (m, mesh) in root.meshes.iter().enumerate() {
+        for (p, prim) in mesh.primitives.iter().enumerate() {
+            let attrs = prim.attributes.iter().map(|(sem, i)| (format!("attribute {}", semantic_name(sem)), i.value()));
+            let all = attrs.chain(prim.indices.map(|i| ("indices".to_string(), i.value())));
+            for (what, i) in all {
+                if i >= n {
+                    return Err(format!(
+                        "mesh {m}, primitive {p}: {what} names accessor {i}, but the file has {n} accessors"
+                    ));
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
+/// The glTF name of an attribute semantic (`POSITION`, `NORMAL`, ...).
+fn semantic_name(sem: &::gltf::json::validation::Checked<Semantic>) -> String {
+    match sem {
+        ::gltf::json::validation::Checked::Valid(s) => s.to_string(),
+        ::gltf::json::validation::Checked::Invalid => "(unknown)".to_string(),
+    }
+}
+
 /// The `gltf` crate subtracts the header size from the GLB's length field unchecked (an overflow
 /// panic in debug builds): check the header first.
 fn check_glb_header(bytes: &[u8]) -> Result<(), String> {
@@ -109,7 +146,12 @@ fn check_glb_header(bytes: &[u8]) -> Result<(), String> {
 }
 
 /// Reads every buffer (GLB chunk, data URI or external file), naming the buffer that fails.
-fn load_buffers(path: &Path, doc: &Document, mut blob: Option<Vec<u8>>) -> Result<Vec<::gltf::buffer::Data>> {
+fn load_buffers(
+    path: &Path,
+    doc: &Document,
+    mut blob: Option<Vec<u8>>,
+    opts: LoadOptions,
+) -> Result<Vec<::gltf::buffer::Data>> {
     let base = path.parent().unwrap_or(Path::new("."));
     let mut out = Vec::new();
     for buffer in doc.buffers() {
@@ -117,17 +159,35 @@ fn load_buffers(path: &Path, doc: &Document, mut blob: Option<Vec<u8>>) -> Resul
             ::gltf::buffer::Source::Uri(uri) if uri.starts_with("data:") => {
                 format!("buffer {} (data URI)", buffer.index())
             }
-            ::gltf::buffer::Source::Uri(uri) => format!("buffer {} ('{}')", buffer.index(), base.join(uri).display()),
+            ::gltf::buffer::Source::Uri(uri) => format!("buffer {} ('{}')", buffer.index(), short(uri)),
             ::gltf::buffer::Source::Bin => format!("buffer {} (GLB binary chunk)", buffer.index()),
         };
-        // The crate unwraps the percent-decoding of relative URIs: check it first.
-        if let ::gltf::buffer::Source::Uri(uri) = buffer.source() {
-            if !uri.contains(':') && urlencoding::decode(uri).is_err() {
-                return Err(parse_error(path, None, format!("{what}: the URI is not UTF-8 after percent-decoding")));
+        let data = match buffer.source() {
+            // Files are read here, not by the crate: confined to the scene's folder and bounded.
+            ::gltf::buffer::Source::Uri(uri) if !uri.starts_with("data:") => {
+                let Ok(decoded) = urlencoding::decode(uri) else {
+                    return Err(parse_error(
+                        path,
+                        None,
+                        format!("{what}: the URI is not UTF-8 after percent-decoding"),
+                    ));
+                };
+                let label = format!("buffer {} URI", buffer.index());
+                let file = resolve_in_scene(base, &decoded, &label, opts).map_err(|m| parse_error(path, None, m))?;
+                let bytes = read_bounded(&file, MAX_INPUT_BYTES).map_err(|e| match e {
+                    Error::Io { source, .. } => parse_error(path, None, format!("cannot load {what}: {source}")),
+                    e => parse_error(path, None, format!("cannot load {what}: {e}")),
+                })?;
+                ::gltf::buffer::Data(bytes)
             }
-        }
-        let data = ::gltf::buffer::Data::from_source_and_blob(buffer.source(), Some(base), &mut blob)
-            .map_err(|e| parse_error(path, None, format!("cannot load {what}: {e}")))?;
+            source => ::gltf::buffer::Data::from_source_and_blob(source, Some(base), &mut blob).map_err(|e| {
+                let m = match e {
+                    ::gltf::Error::Base64(_) => "the data URI is not valid base64".to_string(),
+                    e => e.to_string(),
+                };
+                parse_error(path, None, format!("cannot load {what}: {m}"))
+            })?,
+        };
         if data.len() < buffer.length() {
             let m = format!("{what} has {} bytes, but byteLength is {}", data.len(), buffer.length());
             return Err(parse_error(path, None, m));
@@ -221,7 +281,7 @@ impl Loader<'_> {
             return Err(format!("{} indices (vertices) is not a multiple of 3 for TRIANGLES", indices.len()));
         }
         let flip = world.determinant() < 0.0;
-        let (m, mat) = self.material(prim.material());
+        let (m, mat) = self.material(prim.material())?;
         for (k, t) in triangles(mode, &indices).enumerate() {
             let [a, b, c] = t.map(|i| positions[i as usize]);
             let (b, c) = if flip { (c, b) } else { (b, c) };
@@ -235,10 +295,10 @@ impl Loader<'_> {
     }
 
     /// Our material for a glTF material, created on first use.
-    fn material(&mut self, m: ::gltf::Material) -> (MaterialId, Material) {
+    fn material(&mut self, m: ::gltf::Material) -> Result<(MaterialId, Material), String> {
         let slot = m.index().unwrap_or(self.materials.len() - 1);
         if let Some(done) = &self.materials[slot] {
-            return done.clone();
+            return Ok(done.clone());
         }
         let mat = match m.index() {
             None => Material::diffuse("default", Vec3::splat(0.8)),
@@ -255,16 +315,20 @@ impl Loader<'_> {
                     self.ignored.push((what.to_string(), name.clone()));
                 }
                 let strength = m.emissive_strength().unwrap_or(1.0);
-                Material {
-                    name,
-                    albedo: Vec3::new(base[0], base[1], base[2]).clamp(Vec3::ZERO, Vec3::ONE),
-                    emission: Vec3::from(m.emissive_factor()) * strength,
+                let emission = Vec3::from(m.emissive_factor()) * strength;
+                if !emission.is_finite() || strength.is_nan() || strength < 0.0 {
+                    return Err(format!(
+                        "material {i}: emissiveFactor {} times KHR_materials_emissive_strength.emissiveStrength {strength} must be finite and non-negative (at most {:e} in f32)",
+                        Vec3::from(m.emissive_factor()),
+                        f32::MAX
+                    ));
                 }
+                Material { name, albedo: Vec3::new(base[0], base[1], base[2]).clamp(Vec3::ZERO, Vec3::ONE), emission }
             }
         };
         let id = self.builder.material(mat.clone());
         self.materials[slot] = Some((id, mat.clone()));
-        (id, mat)
+        Ok((id, mat))
     }
 
     /// Takes the node's camera if it is perspective.

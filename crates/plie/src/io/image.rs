@@ -38,6 +38,14 @@ impl ImageFormat {
             "png" => Ok(ImageFormat::Png),
             "exr" => Ok(ImageFormat::Exr),
             "pfm" => Ok(ImageFormat::Pfm),
+            "" if path.is_dir() => Err(Error::Image {
+                path: path.to_path_buf(),
+                message: format!("is a directory; give an image file name ({})", Self::EXTENSIONS),
+            }),
+            "" => Err(Error::Image {
+                path: path.to_path_buf(),
+                message: format!("has no extension to choose the image format; supported: {}", Self::EXTENSIONS),
+            }),
             _ => Err(Error::Image {
                 path: path.to_path_buf(),
                 message: format!("unknown image format '.{ext}'; supported: {}", Self::EXTENSIONS),
@@ -111,7 +119,7 @@ pub fn encode_pfm(width: u32, height: u32, radiance: &[Vec3]) -> Vec<u8> {
 /// and greyscale (`Pf`, expanded to grey RGB) maps of either byte order; rejects anything malformed,
 /// truncated or with trailing bytes.
 pub fn load_pfm(path: &Path) -> Result<(u32, u32, Vec<Vec3>)> {
-    let bytes = std::fs::read(path).map_err(|source| Error::Io { path: path.to_path_buf(), source })?;
+    let bytes = super::input::read_bounded(path, super::input::MAX_INPUT_BYTES)?;
     decode_pfm(&bytes).map_err(|m| parse_error(path, None, m))
 }
 

@@ -6,6 +6,8 @@
 //! - [`save_image`] writes radiance; [`load_pfm`] reads a PFM back for bit-exact comparisons.
 //! - [`gltf_export::save_inspection_gltf`] writes what `plie inspect` shows as a glTF scene.
 //! - [`write_atomic`] is the only way files are written: a temporary file, fsync, rename.
+//! - [`input`] is the only way files are read: regular files only, bounded in size, and files named
+//!   inside a scene only from the scene's folder unless [`LoadOptions::allow_outside_paths`].
 //!
 //! Every error names the file and, where the format has lines, the line. Loaders never panic on input;
 //! what the underlying crates would panic on is checked before they see it.
@@ -14,6 +16,7 @@ pub mod atomic;
 pub mod gltf;
 pub mod gltf_export;
 pub mod image;
+pub mod input;
 pub mod lights;
 pub mod obj;
 mod obj_lines;
@@ -23,6 +26,7 @@ use std::path::Path;
 
 pub use atomic::{write_atomic, WriteSeek};
 pub use image::{load_pfm, save_image, ImageFormat};
+pub use input::LoadOptions;
 
 use crate::error::{Error, Result};
 use crate::scene::Scene;
@@ -32,12 +36,18 @@ pub const SCENE_EXTENSIONS: [&str; 3] = ["obj", "gltf", "glb"];
 
 /// Loads a scene file, choosing the format by extension (case-insensitive): `.obj` (with its MTL
 /// files), `.gltf` or `.glb`. The scene is named after the file stem. The file's camera, if any, becomes
-/// the scene camera; otherwise [`Scene::camera`] is `None`.
+/// the scene camera; otherwise [`Scene::camera`] is `None`. Files the scene names are read only from
+/// its own folder ([`LoadOptions::default`]).
 pub fn load_scene(path: &Path) -> Result<Scene> {
+    load_scene_with(path, LoadOptions::default())
+}
+
+/// [`load_scene`] with options.
+pub fn load_scene_with(path: &Path, opts: LoadOptions) -> Result<Scene> {
     let ext = path.extension().map(|e| e.to_string_lossy().to_ascii_lowercase()).unwrap_or_default();
     match ext.as_str() {
-        "obj" => obj::load_obj(path),
-        "gltf" | "glb" => gltf::load_gltf(path),
+        "obj" => obj::load_obj_with(path, opts),
+        "gltf" | "glb" => gltf::load_gltf_with(path, opts),
         _ => Err(parse_error(
             path,
             None,

@@ -19,27 +19,33 @@
 use std::cell::RefCell;
 use std::collections::{HashMap, HashSet};
 use std::fmt::Write as _;
-use std::fs::File;
 use std::io::BufReader;
 use std::path::{Path, PathBuf};
 use std::str::SplitWhitespace;
 
 use glam::Vec3;
 
+use super::input::{open_regular, resolve_in_scene, short, LoadOptions, MAX_INPUT_BYTES};
 use super::lights::{self, EmissiveTriangle};
 use super::obj_lines::{parse_finite, rest_after_keyword, strip_comment, LineFilter, LineRules};
 use super::{material_warnings, parse_error, scene_name};
 use crate::error::{Error, Result};
 use crate::scene::{Material, MaterialId, Scene, SceneBuilder};
 
-/// Loads an OBJ file and the MTL files it names (see the module doc).
+/// Loads an OBJ file and the MTL files it names (see the module doc), the MTL files only from the
+/// OBJ's folder.
 pub fn load_obj(path: &Path) -> Result<Scene> {
-    let file = File::open(path).map_err(|source| Error::Io { path: path.to_path_buf(), source })?;
+    load_obj_with(path, LoadOptions::default())
+}
+
+/// [`load_obj`] with options.
+pub fn load_obj_with(path: &Path, opts: LoadOptions) -> Result<Scene> {
+    let file = open_regular(path, MAX_INPUT_BYTES)?;
     let libs = RefCell::new(Libraries::default());
     let dir = path.parent().unwrap_or(Path::new(""));
     let mut reader = LineFilter::new(BufReader::new(file), ObjRules::new(&libs));
     let options = tobj::LoadOptions { triangulate: true, single_index: true, ignore_points: true, ignore_lines: true };
-    let result = tobj::load_obj_buf(&mut reader, &options, |lib| load_libraries(path, dir, lib, &libs));
+    let result = tobj::load_obj_buf(&mut reader, &options, |lib| load_libraries(path, dir, lib, &libs, opts));
     if let Some(e) = libs.borrow_mut().error.take() {
         return Err(e);
     }
@@ -124,7 +130,7 @@ impl<'a> ObjRules<'a> {
         let mut k = 0usize;
         for token in words {
             let index = token.split('/').next().unwrap_or("");
-            let i: i64 = index.parse().map_err(|_| format!("malformed vertex index '{token}' in a face"))?;
+            let i: i64 = index.parse().map_err(|_| format!("malformed vertex index '{}' in a face", short(token)))?;
             let absolute = match i {
                 0 => return Err("vertex index 0 in a face (OBJ indices start at 1)".into()),
                 i if i > 0 && i as u64 <= v => i as u64,
@@ -148,9 +154,9 @@ impl<'a> ObjRules<'a> {
         let libs = self.libs.borrow();
         if !libs.names.contains(name) {
             return Err(if libs.libs.is_empty() {
-                format!("usemtl '{name}', but no mtllib comes before it: the material is not defined")
+                format!("usemtl '{}', but no mtllib comes before it: the material is not defined", short(name))
             } else {
-                format!("usemtl '{name}': no material of that name in {}", libs.libs.join(", "))
+                format!("usemtl '{}': no material of that name in {}", short(name), short(&libs.libs.join(", ")))
             });
         }
         let _ = write!(out, "usemtl {name}");
@@ -254,14 +260,28 @@ impl LineRules for MtlRules<'_> {
 
 /// The `tobj` material loader: loads the library (or libraries) named on one `mtllib` line. Errors are
 /// kept in `libs` (tobj would only keep a bare error kind and go on).
-fn load_libraries(obj: &Path, dir: &Path, lib: &Path, libs: &RefCell<Libraries>) -> tobj::MTLLoadResult {
-    let whole = dir.join(lib);
+fn load_libraries(
+    obj: &Path,
+    dir: &Path,
+    lib: &Path,
+    libs: &RefCell<Libraries>,
+    opts: LoadOptions,
+) -> tobj::MTLLoadResult {
     let name = lib.to_string_lossy();
-    let files: Vec<PathBuf> = if whole.is_file() || !name.contains(char::is_whitespace) {
-        vec![whole]
+    let names: Vec<&str> = if dir.join(lib).is_file() || !name.contains(char::is_whitespace) {
+        vec![&name]
     } else {
-        name.split_whitespace().map(|n| dir.join(n)).collect()
+        name.split_whitespace().collect()
     };
+    let line = libs.borrow().line;
+    let mut files: Vec<PathBuf> = Vec::new();
+    for n in names {
+        let file = resolve_in_scene(dir, n, "mtllib", opts).map_err(|m| {
+            libs.borrow_mut().error.get_or_insert(parse_error(obj, Some(line), m));
+            tobj::LoadError::OpenFileFailed
+        })?;
+        files.push(file);
+    }
     let (mut all, mut map): (Vec<tobj::Material>, _) = (Vec::new(), Default::default());
     for file in files {
         let (mut mats, names) = load_library(obj, &file, libs)?;
@@ -286,9 +306,8 @@ fn load_library(obj: &Path, file: &Path, libs: &RefCell<Libraries>) -> tobj::MTL
         tobj::LoadError::OpenFileFailed
     };
     let line = libs.borrow().line;
-    let f = File::open(file).map_err(|e| {
-        fail(parse_error(obj, Some(line), format!("mtllib: cannot open material library {}: {e}", file.display())))
-    })?;
+    let f = open_regular(file, MAX_INPUT_BYTES)
+        .map_err(|e| fail(parse_error(obj, Some(line), format!("mtllib: cannot open material library {e}"))))?;
     let dir = file.parent().unwrap_or(Path::new("")).to_path_buf();
     let mut reader = LineFilter::new(BufReader::new(f), MtlRules { libs, dir, material: String::new() });
     let result = tobj::load_mtl_buf(&mut reader);

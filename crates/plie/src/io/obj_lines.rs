@@ -10,6 +10,10 @@
 
 use std::io::{self, BufRead, Read};
 
+/// The longest line read (16 MiB): a longer one is an error, so a file without line breaks cannot
+/// make the reader allocate without bound.
+pub(super) const MAX_LINE_BYTES: u64 = 16 << 20;
+
 /// Checks and rewrites one line of a file for `tobj`.
 pub(super) trait LineRules {
     /// Writes the line (1-based number `line`, no line ending) as `tobj` should see it into `out` (empty
@@ -60,7 +64,7 @@ impl<R: BufRead, L: LineRules> LineFilter<R, L> {
             return Ok(());
         }
         self.raw.clear();
-        let n = match self.inner.read_until(b'\n', &mut self.raw) {
+        let n = match (&mut self.inner).take(MAX_LINE_BYTES + 1).read_until(b'\n', &mut self.raw) {
             Ok(n) => n,
             Err(e) => {
                 self.line += 1;
@@ -71,6 +75,9 @@ impl<R: BufRead, L: LineRules> LineFilter<R, L> {
             return Ok(());
         }
         self.line += 1;
+        if self.raw.len() as u64 > MAX_LINE_BYTES {
+            return Err(self.fail(format!("the line is longer than the limit of {MAX_LINE_BYTES} bytes")));
+        }
         let complete = self.raw.last() == Some(&b'\n');
         let mut end = self.raw.len() - usize::from(complete);
         if end > 0 && self.raw[end - 1] == b'\r' {
@@ -138,8 +145,8 @@ pub(super) fn rest_after_keyword<'a>(line: &'a str, keyword: &str) -> &'a str {
 pub(super) fn parse_finite<S: std::fmt::Display>(token: &str, what: impl Fn() -> S) -> Result<f32, String> {
     match token.parse::<f32>() {
         Ok(x) if x.is_finite() => Ok(x),
-        Ok(_) => Err(format!("{} has a non-finite value '{token}'", what())),
-        Err(_) => Err(format!("malformed number '{token}' in {}", what())),
+        Ok(_) => Err(format!("{} has a non-finite value '{}'", what(), super::input::short(token))),
+        Err(_) => Err(format!("malformed number '{}' in {}", super::input::short(token), what())),
     }
 }
 
@@ -175,6 +182,16 @@ mod tests {
         let (line, msg) = f.error().unwrap();
         assert_eq!(*line, 2);
         assert!(msg.contains("truncated"), "{msg}");
+    }
+
+    #[test]
+    fn lines_are_bounded() {
+        let long = vec![b'x'; MAX_LINE_BYTES as usize + 10];
+        let mut f = LineFilter::new(&long[..], Upper);
+        assert!((&mut f).lines().next().unwrap().is_err());
+        let (line, msg) = f.error().unwrap();
+        assert_eq!(*line, 1);
+        assert!(msg.contains("longer than the limit"), "{msg}");
     }
 
     #[test]

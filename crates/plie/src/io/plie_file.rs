@@ -25,7 +25,7 @@ use xxhash_rust::xxh3::{xxh3_64, Xxh3};
 
 use super::atomic::write_atomic;
 use crate::error::{Error, Result};
-use crate::lie::{Plie, PlieParams, RecordKind, NO_RECORD, SCENE_CELL, UMBRA_CELL};
+use crate::lie::{Plie, PlieParams, RecordKind, CHUNKED_MIN, NO_RECORD, SCENE_CELL, UMBRA_CELL};
 use crate::octree::Octree;
 use crate::scene::Scene;
 
@@ -46,6 +46,11 @@ pub struct FileBody {
     pub octree_fingerprint: u64,
     /// The P-LIE.
     pub plie: Plie,
+}
+
+/// The checksum a `.plie` header stores for `payload` (XXH3-64).
+pub fn checksum(payload: &[u8]) -> u64 {
+    xxh3_64(payload)
 }
 
 /// A hash of everything that shapes the P-LIE: triangles, their materials' emission, lights.
@@ -118,7 +123,7 @@ pub fn save_plie(path: &Path, scene: &Scene, octree: &Octree, plie: &Plie) -> Re
 /// not matter, modes use them when present), rebuilds the octree and checks that it is the one the
 /// P-LIE was built on. Returns the octree and the P-LIE.
 pub fn load_plie(path: &Path, scene: &Scene, expect: Option<PlieParams>) -> Result<(Octree, Plie)> {
-    let bytes = std::fs::read(path).map_err(|source| Error::Io { path: path.to_path_buf(), source })?;
+    let bytes = super::input::read_bounded(path, super::input::MAX_INPUT_BYTES)?;
     let bad = |m: String| Error::Parse { path: path.to_path_buf(), line: None, message: m };
     if bytes.len() < 8 || bytes[..8] != MAGIC {
         return Err(bad("not a .plie file (wrong magic bytes)".into()));
@@ -145,13 +150,16 @@ pub fn load_plie(path: &Path, scene: &Scene, expect: Option<PlieParams>) -> Resu
         return Err(bad("corrupted .plie file (checksum mismatch)".into()));
     }
     let body: FileBody =
-        postcard::from_bytes(payload).map_err(|e| bad(format!("corrupted .plie file (cannot decode: {e})")))?;
+        postcard::from_bytes(payload).map_err(|_| {
+        bad("corrupted .plie file: the checksum matches but the content is not a P-LIE (written by another program or altered): rebuild it with `plie build`".into())
+    })?;
     if body.scene_fingerprint != scene_fingerprint(scene) {
         return Err(bad(format!("was built for another scene, not '{}' (rebuild it with `plie build`)", scene.name)));
     }
     if let Some(p) = expect {
         if p.octree() != body.params.octree() || p.refine != body.params.refine {
-            return Err(bad(format!("was built with other parameters ({:?}) than asked for ({p:?})", body.params)));
+            let (file, asked) = (describe_params(&body.params), describe_params(&p));
+            return Err(bad(format!("was built with other parameters ({file}) than asked for ({asked})")));
         }
     }
     body.params.octree().validate().map_err(|e| bad(format!("invalid parameters in file: {e}")))?;
@@ -165,6 +173,31 @@ pub fn load_plie(path: &Path, scene: &Scene, expect: Option<PlieParams>) -> Resu
     }
     check_structure(&body.plie, scene, &octree).map_err(|m| bad(format!("inconsistent .plie file: {m}")))?;
     Ok((octree, body.plie))
+}
+
+/// The parameters that must match, as the command-line options that set them.
+fn describe_params(p: &PlieParams) -> String {
+    let r = &p.refine;
+    let mut refine: Vec<&str> = Vec::new();
+    if r.umbra_full {
+        refine.push("umbra-full");
+    }
+    if r.umbra_free {
+        refine.push("umbra-free");
+    }
+    if r.blockers.is_some() {
+        refine.push("blockers");
+    }
+    let mut s = format!("--max-triangles {} --max-depth {}", p.max_triangles, p.max_depth);
+    if !refine.is_empty() {
+        s += &format!(" --refine {} --max-split-depth {}", refine.join(","), r.max_split_depth);
+    }
+    match r.blockers {
+        Some(crate::construct::refine::MaxBlockers::Fixed(n)) => s += &format!(" --max-blockers {n}"),
+        Some(crate::construct::refine::MaxBlockers::Adaptive) => s += " --max-blockers adaptive",
+        None => {}
+    }
+    s
 }
 
 /// Every index in range, every record where the index says it is.
@@ -196,6 +229,15 @@ fn check_structure(p: &Plie, scene: &Scene, octree: &Octree) -> std::result::Res
         if end > p.blockers.len() as u64 {
             return Err(format!("record {i}: blocker range out of bounds"));
         }
+    }
+    // Short lists are promised in ascending id order (long ones in Morton order, see `CHUNKED_MIN`).
+    let ascending = |l: &[crate::scene::TriId]| l.len() >= CHUNKED_MIN || l.windows(2).all(|w| w[0].0 <= w[1].0);
+    if let Some(i) = p.records.iter().position(|r| !ascending(p.blockers_of(r))) {
+        return Err(format!("record {i}: blocker list out of order"));
+    }
+    let cell_list = |&(start, len): &(u32, u32)| p.cell_blockers.get(start as usize..start as usize + len as usize);
+    if p.cells.iter().filter(|&&c| c != UMBRA_CELL).any(|c| cell_list(c).is_some_and(|l| !ascending(l))) {
+        return Err("grid cell blocker list out of order".into());
     }
     if let Some(t) = p.blockers.iter().chain(&p.cell_blockers).find(|t| t.idx() >= scene.triangles.len()) {
         return Err(format!("blocker triangle {} out of range", t.0));

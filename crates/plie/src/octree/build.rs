@@ -7,6 +7,12 @@
 //! test ([`triangle_overlaps_box`]); a cheap bounding-box pre-filter with a `2 eps` slack only skips
 //! children the exact test would reject too.
 //!
+//! Exact copies of a triangle (the same three vertices, in any order) count once toward
+//! `max_triangles`: no split can ever separate them, so a cell with more than `max_triangles`
+//! triangles but few distinct ones would split to `max_depth` wherever the copies lie. A face line
+//! `f 1 2 3 1 2 3 ...` adding 200 copies of the Cornell box's floor triangle made 1,220,836 leaves
+//! that way; counting distinct triangles the split stops as soon as it could not reduce the count.
+//!
 //! The build runs level by level. For one level, the cells to split are split in parallel (rayon,
 //! and large triangle lists in parallel chunks); the results are then placed into the flat arrays by
 //! one sequential pass in cell order. Every value is a pure function of the scene and the parameters,
@@ -81,13 +87,17 @@ impl Octree {
             depth: 0,
             scene_triangles: n,
         };
+        let first_copy = first_copies(scene);
         let all = (0..n as u32).map(TriId).collect();
         let mut frontier = vec![Pending { node: 0, bounds: root, depth: 0, tris: all }];
         while !frontier.is_empty() {
             let splits: Vec<Option<Split>> = frontier
                 .par_iter()
                 .map(|p| {
-                    let split = p.depth == 0 || (p.tris.len() > params.max_triangles && p.depth < params.max_depth);
+                    let split = p.depth == 0
+                        || (p.depth < params.max_depth
+                            && p.tris.len() > params.max_triangles
+                            && distinct(&p.tris, &first_copy) > params.max_triangles);
                     split.then(|| split_cell(scene, &p.tris, &p.bounds, eps))
                 })
                 .collect();
@@ -148,6 +158,26 @@ impl Octree {
         self.leaves.push(Leaf { node, depth, start, end: self.leaf_tris.len() as u32 });
         self.depth = self.depth.max(depth);
     }
+}
+
+/// For every triangle, whether it is the first of its exact copies (the same vertices, in any order,
+/// compared bit for bit). Copies overlap the same cells, so a cell holding a copy holds its first.
+fn first_copies(scene: &Scene) -> Vec<bool> {
+    let mut seen = std::collections::HashSet::with_capacity(scene.triangles.len());
+    scene
+        .triangles
+        .iter()
+        .map(|t| {
+            let mut key = t.v.map(|v| v.to_array().map(f32::to_bits));
+            key.sort_unstable();
+            seen.insert(key)
+        })
+        .collect()
+}
+
+/// The number of distinct triangles of a cell (exact copies counted once).
+fn distinct(tris: &[TriId], first_copy: &[bool]) -> usize {
+    tris.iter().filter(|t| first_copy[t.idx()]).count()
 }
 
 /// Distributes a cell's triangles over its 8 children (each list keeps the parent's order).
@@ -238,6 +268,51 @@ mod tests {
         assert_eq!(o.depth(), 5, "the shared vertex forces splitting to max_depth");
         for l in o.leaves() {
             assert!(o.leaf_triangles(l).len() <= 4 || o.leaf_depth(l) == 5);
+        }
+    }
+
+    /// A unit floor (two triangles) with `copies` more copies of its first triangle (vertices in
+    /// rotated order too), a wall standing on it, and a light.
+    fn coincident_floor(copies: usize) -> Scene {
+        let mut b = SceneBuilder::new("coincident");
+        let m = b.diffuse("grey", Vec3::splat(0.5));
+        let [p, q, r, s] = [Vec3::ZERO, Vec3::X, Vec3::new(1.0, 0.0, 1.0), Vec3::Z];
+        for i in 0..=copies {
+            if i % 2 == 0 {
+                b.triangle(p, r, q, m);
+            } else {
+                b.triangle(r, q, p, m);
+            }
+        }
+        b.triangle(p, s, r, m);
+        b.triangle(Vec3::new(0.3, 0.0, 0.2), Vec3::new(0.7, 0.0, 0.6), Vec3::new(0.5, 0.5, 0.4), m);
+        b.light("light", &[Vec3::new(0.4, 0.9, 0.4), Vec3::new(0.6, 0.9, 0.4), Vec3::new(0.6, 0.9, 0.6)], Vec3::ONE);
+        b.build().expect("valid scene")
+    }
+
+    #[test]
+    fn coincident_triangles_do_not_explode_the_octree() {
+        // Issue 16: 201 coincident triangles split to depth 10 into 1,220,836 leaves.
+        for copies in [200, 400] {
+            let s = coincident_floor(copies);
+            assert_eq!(s.triangles.len(), copies + 4);
+            let o = Octree::build(&s, OctreeParams { max_triangles: 200, max_depth: 10 });
+            assert_eq!((o.leaf_count(), o.depth()), (8, 1), "{copies} copies: only the root is split");
+            // Every triangle is still in the leaves it overlaps: the rule only stops splitting.
+            let mut seen = vec![false; s.triangles.len()];
+            for l in o.leaves() {
+                o.leaf_triangles(l).iter().for_each(|t| seen[t.idx()] = true);
+            }
+            assert!(seen.iter().all(|&x| x));
+        }
+        // With a lower limit the distinct triangles are still separated as before.
+        let s = coincident_floor(200);
+        let o = Octree::build(&s, OctreeParams { max_triangles: 2, max_depth: 10 });
+        assert!(o.depth() > 1 && o.leaf_count() < 4096, "{} leaves, depth {}", o.leaf_count(), o.depth());
+        for l in o.leaves() {
+            let tris = o.leaf_triangles(l);
+            let d = distinct(tris, &first_copies(&s));
+            assert!(d <= 2 || o.leaf_depth(l) == 10, "leaf with {d} distinct triangles above max_depth");
         }
     }
 

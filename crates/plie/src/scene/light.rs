@@ -27,12 +27,21 @@ pub struct Light {
     parallelogram: bool,
 }
 
+/// The first points of a list as `[x, y, z], ...` for messages (at most 4, then how many more).
+pub(crate) fn list_points(points: &[Vec3]) -> String {
+    let mut s: Vec<String> = points.iter().take(4).map(|p| p.to_string()).collect();
+    if points.len() > 4 {
+        s.push(format!("... ({} in all)", points.len()));
+    }
+    s.join(", ")
+}
+
 impl Light {
     /// A light from a convex polygon (counter-clockwise around the emitting side) and its radiance.
     /// Fails on fewer than 3 vertices, non-finite values, zero area, a non-planar or non-convex polygon,
     /// or a radiance that is negative, non-finite or zero.
     pub fn new(vertices: Vec<Vec3>, radiance: Vec3, triangles: Vec<TriId>) -> Result<Light> {
-        let bad = |m: &str| Error::InvalidScene(format!("light with vertices {vertices:?}: {m}"));
+        let bad = |m: &str| Error::InvalidScene(format!("light with vertices {}: {m}", list_points(&vertices)));
         if vertices.len() < 3 {
             return Err(bad("fewer than 3 vertices"));
         }

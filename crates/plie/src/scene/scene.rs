@@ -168,7 +168,7 @@ impl SceneBuilder {
         }
         for (i, t) in self.triangles.iter().enumerate() {
             if !t.v.iter().all(|v| v.is_finite()) {
-                return bad(format!("triangle {i} has a non-finite coordinate: {:?}", t.v));
+                return bad(format!("triangle {i} has a non-finite coordinate: {}", super::light::list_points(&t.v)));
             }
             let m = self.tri_material[i];
             if m.idx() >= self.materials.len() {

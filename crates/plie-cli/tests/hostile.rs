@@ -1,0 +1,318 @@
+//! Issue 16, hostile input: one regression test per reported case. Each asserts the clean outcome:
+//! a non-zero exit, a one-line message naming the file, line or field and the limit, no panic, inputs
+//! unchanged, and (where the case was a hang or a blow-up) a time and address-space bound the test
+//! enforces by killing the process.
+
+mod support;
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output, Stdio};
+use std::time::{Duration, Instant};
+
+use support::{fails_with, plie, stderr};
+
+fn write(dir: &Path, name: &str, bytes: impl AsRef<[u8]>) -> PathBuf {
+    let p = dir.join(name);
+    std::fs::write(&p, bytes).unwrap();
+    p
+}
+
+fn s(p: &Path) -> &str {
+    p.to_str().unwrap()
+}
+
+const BOX_OBJ: &str = "mtllib box.mtl\nv 0 0 0\nv 1 0 0\nv 1 0 1\nv 0 0 1\nv 0 1 0\nv 0 1 1\nv 1 1 1\nv 1 1 0\n\
+usemtl white\nf 1 3 2\nf 1 4 3\nusemtl lamp\nf 5 8 7\nf 5 7 6\n";
+const BOX_MTL: &str = "newmtl white\nKd 0.8 0.8 0.8\nnewmtl lamp\nKd 0 0 0\nKe 5 5 5\n";
+
+/// Runs `plie args` with an address-space limit of `mem_mb` MiB (through `sh -c ulimit -v`) and
+/// kills it after `limit`; returns its output and whether it finished in time.
+fn plie_bounded(args: &[&str], mem_mb: u64, limit: Duration) -> (Output, bool) {
+    let script = format!("ulimit -v {}; exec \"$0\" \"$@\"", mem_mb * 1024);
+    let mut child = Command::new("sh")
+        .arg("-c")
+        .arg(script)
+        .arg(env!("CARGO_BIN_EXE_plie"))
+        .args(args)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("run plie");
+    let start = Instant::now();
+    let mut in_time = true;
+    while child.try_wait().unwrap().is_none() {
+        if start.elapsed() > limit {
+            child.kill().unwrap();
+            in_time = false;
+            break;
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    (child.wait_with_output().unwrap(), in_time)
+}
+
+/// A one-line error without a panic, containing every needle.
+fn one_line_error(o: &Output, needles: &[&str]) -> String {
+    let err = stderr(o);
+    assert!(!o.status.success(), "should fail; stderr: {err}");
+    assert_eq!(o.status.code(), Some(1), "a clean error exit, not a crash: {err}");
+    assert!(!err.contains("panicked"), "{err}");
+    let lines: Vec<&str> = err.lines().filter(|l| !l.trim().is_empty()).collect();
+    assert_eq!(lines.len(), 1, "one line: {err}");
+    for n in needles {
+        assert!(err.contains(n), "error should mention '{n}': {err}");
+    }
+    err
+}
+
+/// A minimal glTF around `mesh`/`extra` members, with an embedded 3-triangle buffer when `buffer`.
+fn gltf(members: &str) -> String {
+    format!(r#"{{"asset": {{"version": "2.0"}}, "scenes": [{{"nodes": [0]}}], "nodes": [{{"mesh": 0}}], {members}}}"#)
+}
+
+// 1. A primitive naming an accessor that does not exist once made the gltf crate panic.
+#[test]
+fn gltf_without_accessors_is_an_error() {
+    let dir = tempfile::tempdir().unwrap();
+    let g = write(dir.path(), "noacc.gltf", gltf(r#""meshes": [{"primitives": [{"attributes": {"POSITION": 0}}]}]"#));
+    let png = dir.path().join("o.png");
+    let lie = dir.path().join("o.plie");
+    for args in [["render", "--scene", s(&g), "-o", s(&png)], ["build", "--scene", s(&g), "-o", s(&lie)]] {
+        one_line_error(&plie(&args), &["noacc.gltf", "accessor 0", "0 accessors"]);
+    }
+}
+
+// 2. 201 coincident triangles (a 600-index face repeating the floor) split the octree into
+//    1,220,836 leaves and took 18 s for a 16x16 render.
+#[test]
+fn coincident_triangles_render_quickly_in_bounded_memory() {
+    render_copies(200);
+}
+
+/// The issue's 1,200-index face (401 coincident triangles): the octree is fine, but the BVH (obvhs)
+/// built over 401 identical boxes is deeper than its 32-entry traversal stack; the test profile's
+/// debug assertions catch it in `CwBvh::validate`. Not fixed on this branch: see docs/robustness.md.
+#[test]
+#[ignore = "obvhs builds a BVH deeper than its traversal stack over 401 identical boxes"]
+fn four_hundred_coincident_triangles() {
+    render_copies(400);
+}
+
+/// Renders the box with `copies` more copies of a floor triangle under 4 GiB and 120 s.
+fn render_copies(copies: usize) {
+    let dir = tempfile::tempdir().unwrap();
+    write(dir.path(), "box.mtl", BOX_MTL);
+    let face = format!("usemtl white\nf{}\n", " 1 3 2".repeat(copies));
+    let obj = write(dir.path(), &format!("c{copies}.obj"), format!("{BOX_OBJ}{face}"));
+    let out = dir.path().join("c.png");
+    let args =
+        ["render", "--scene", s(&obj), "-o", s(&out), "--width", "16", "--height", "16", "--json", "--threads", "2"];
+    let (o, in_time) = plie_bounded(&args, 4096, Duration::from_secs(120));
+    assert!(in_time, "{copies} copies: killed after 120 s");
+    assert!(o.status.success(), "{copies} copies: {}", stderr(&o));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let leaves = v["octree_leaves"].as_u64().unwrap();
+    assert_eq!(leaves, 8, "{copies} copies: {leaves} octree leaves");
+}
+
+// 3. Unbounded reads: `mtllib /dev/zero` aborted, a glTF buffer `/dev/urandom` hung.
+#[test]
+fn devices_are_not_read() {
+    if !Path::new("/dev/zero").exists() {
+        eprintln!("notice: no /dev/zero; skipping");
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let obj = write(dir.path(), "z.obj", BOX_OBJ.replace("box.mtl", "/dev/zero"));
+    let out = dir.path().join("o.png");
+    let base = ["--width", "8", "--height", "8"];
+    let mut args = vec!["render", "--scene", s(&obj), "-o", s(&out), "--allow-outside-paths"];
+    args.extend(base);
+    let (o, in_time) = plie_bounded(&args, 2048, Duration::from_secs(30));
+    assert!(in_time);
+    one_line_error(&o, &["z.obj:1", "/dev/zero", "not a regular file"]);
+    let members = r#""buffers": [{"uri": "/dev/urandom", "byteLength": 36}], "meshes": [{"primitives": [{"attributes": {"POSITION": 0}}]}], "accessors": [{"count": 3, "type": "VEC3", "componentType": 5126, "bufferView": 0, "min": [0,0,0], "max": [1,1,1]}], "bufferViews": [{"buffer": 0, "byteLength": 36}]"#;
+    let g = write(dir.path(), "u.gltf", gltf(members));
+    let mut args = vec!["render", "--scene", s(&g), "-o", s(&out), "--allow-outside-paths"];
+    args.extend(base);
+    let (o, in_time) = plie_bounded(&args, 2048, Duration::from_secs(30));
+    assert!(in_time);
+    one_line_error(&o, &["u.gltf", "buffer 0", "not a regular file"]);
+    // `--plie /dev/zero` fails cleanly too.
+    let o = plie(&["render", "--scene", "cornell-cube-1", "-o", s(&out), "--visibility", "lie", "--plie", "/dev/zero"]);
+    one_line_error(&o, &["/dev/zero", "not a regular file"]);
+}
+
+// 4. Outputs overwriting inputs.
+#[test]
+fn outputs_never_overwrite_inputs() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    write(d, "box.mtl", BOX_MTL);
+    let obj = write(d, "x.obj", BOX_OBJ);
+    let o = plie(&["build", "--scene", s(&obj), "-o", s(&obj)]);
+    one_line_error(&o, &["x.obj", "only .plie"]);
+    fails_with(&["build", "--scene", "cornell-cube-1", "-o", s(&d.join("b.pfm"))], "only .plie");
+    // Same file by another spelling.
+    let plie_file = d.join("x.plie");
+    let o = plie(&["build", "--scene", "cornell-cube-1", "-o", s(&plie_file), "--quiet"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let plie_bytes = std::fs::read(&plie_file).unwrap();
+    let pfm = write(d, "p.pfm", &plie_bytes);
+    let o = plie(&["render", "--scene", "cornell-cube-1", "--visibility", "lie", "--plie", s(&pfm), "-o", s(&pfm)]);
+    one_line_error(&o, &["p.pfm", "names an input"]);
+    let g = write(d, "s.gltf", gltf(r#""meshes": []"#));
+    let o = plie(&["inspect", "--scene", s(&g), "--cell", "0,0,0", "-o", s(&g)]);
+    one_line_error(&o, &["s.gltf", "names an input"]);
+    let again = d.join(".").join("x.obj");
+    let o = plie(&["render", "--scene", s(&obj), "-o", s(&again.with_extension("obj"))]);
+    assert!(!o.status.success());
+    assert_eq!(std::fs::read_to_string(&obj).unwrap(), BOX_OBJ, "the scene is unchanged");
+    assert_eq!(std::fs::read(&pfm).unwrap(), plie_bytes, "the P-LIE is unchanged");
+}
+
+// 5. Reading outside the scene's folder.
+#[test]
+fn scene_files_cannot_name_files_outside_their_folder() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let out = d.join("o.png");
+    for uri in ["../../../../etc/passwd", "/etc/passwd", "file:///etc/passwd"] {
+        let members = format!(
+            r#""buffers": [{{"uri": "{uri}", "byteLength": 36}}], "meshes": [{{"primitives": [{{"attributes": {{"POSITION": 0}}}}]}}], "accessors": [{{"count": 3, "type": "VEC3", "componentType": 5126, "bufferView": 0, "min": [0,0,0], "max": [1,1,1]}}], "bufferViews": [{{"buffer": 0, "byteLength": 36}}]"#
+        );
+        let g = write(d, "p.gltf", gltf(&members));
+        let o = plie(&["render", "--scene", s(&g), "-o", s(&out)]);
+        let err = one_line_error(&o, &["p.gltf", "buffer 0", "--allow-outside-paths"]);
+        if let Ok(m) = std::fs::metadata("/etc/passwd") {
+            assert!(!err.contains(&format!("{} bytes", m.len())), "the file's size is not revealed: {err}");
+        }
+    }
+    let obj = write(d, "m.obj", BOX_OBJ.replace("box.mtl", "/etc/passwd"));
+    let o = plie(&["render", "--scene", s(&obj), "-o", s(&out)]);
+    one_line_error(&o, &["m.obj:1", "mtllib", "/etc/passwd", "--allow-outside-paths"]);
+    // With the option, an MTL file elsewhere is read.
+    let lib = tempfile::tempdir().unwrap();
+    let mtl = write(lib.path(), "box.mtl", BOX_MTL);
+    let obj = write(d, "far.obj", BOX_OBJ.replace("box.mtl", s(&mtl)));
+    fails_with(&["render", "--scene", s(&obj), "-o", s(&out)], "outside the scene's folder");
+    let o =
+        plie(&["render", "--scene", s(&obj), "-o", s(&out), "--width", "8", "--height", "8", "--allow-outside-paths"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+}
+
+// 6. Unbounded --threads.
+#[test]
+fn threads_are_bounded() {
+    for t in ["100000", "10000", "0"] {
+        let (o, in_time) = plie_bounded(
+            &["render", "--scene", "cornell-cube-1", "-o", "/tmp/never.png", "--threads", t],
+            2048,
+            Duration::from_secs(10),
+        );
+        assert!(in_time);
+        one_line_error(&o, &["--threads", "between 1 and 1024"]);
+    }
+}
+
+// 7. A corrupted P-LIE with a valid checksum: `plie verify` finds it.
+#[test]
+fn verify_finds_a_corrupted_p_lie_with_a_valid_checksum() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("c.plie");
+    let o = plie(&["build", "--scene", "cornell-cube-1", "-o", s(&file), "--quiet"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    for full in [false, true] {
+        let mut args = vec!["verify", s(&file), "--scene", "cornell-cube-1"];
+        if full {
+            args.push("--full");
+        }
+        let o = plie(&args);
+        assert!(o.status.success(), "{}", stderr(&o));
+        assert!(String::from_utf8_lossy(&o.stdout).contains("OK"));
+    }
+    // The issue's case: 51 bytes zeroed at offset 347, the checksum rewritten.
+    let mut b = std::fs::read(&file).unwrap();
+    assert!(b[347..398].iter().any(|&x| x != 0), "the bytes change");
+    b[347..398].fill(0);
+    let sum = plie::io::plie_file::checksum(&b[28..]);
+    b[20..28].copy_from_slice(&sum.to_le_bytes());
+    let bad = write(dir.path(), "bad.plie", &b);
+    let o = plie(&["verify", s(&bad), "--scene", "cornell-cube-1", "--full"]);
+    one_line_error(&o, &["bad.plie"]);
+    // A payload that is not a P-LIE at all, with a valid checksum.
+    let mut junk = b[..28].to_vec();
+    junk.extend([0xffu8; 64]);
+    junk[12..20].copy_from_slice(&64u64.to_le_bytes());
+    let sum = plie::io::plie_file::checksum(&junk[28..]);
+    junk[20..28].copy_from_slice(&sum.to_le_bytes());
+    let junk = write(dir.path(), "junk.plie", &junk);
+    let o = plie(&["verify", s(&junk), "--scene", "cornell-cube-1"]);
+    let err = one_line_error(&o, &["junk.plie", "not a P-LIE", "plie build"]);
+    assert!(!err.contains("varint") && !err.contains("Serde"), "{err}");
+}
+
+// 8. Messages a user can act on.
+#[test]
+fn messages_name_the_field_and_the_limit() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let out = d.join("o.png");
+    // Parameters of a P-LIE file as options, not Rust's Debug.
+    let file = d.join("p.plie");
+    assert!(plie(&["build", "--scene", "cornell-cube-1", "-o", s(&file), "--quiet"]).status.success());
+    let o = plie(&[
+        "render",
+        "--scene",
+        "cornell-cube-1",
+        "-o",
+        s(&out),
+        "--visibility",
+        "lie",
+        "--plie",
+        s(&file),
+        "--max-triangles",
+        "50",
+    ]);
+    let err = one_line_error(&o, &["p.plie", "--max-triangles 200", "--max-triangles 50"]);
+    assert!(!err.contains("PlieParams") && !err.contains("RefineParams"), "{err}");
+    // emissiveStrength 1e308: the field is named.
+    let members = r#""buffers": [{"uri": "data:application/octet-stream;base64,AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAgD8AAAAA", "byteLength": 36}], "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "material": 0}]}], "materials": [{"emissiveFactor": [1, 1, 1], "extensions": {"KHR_materials_emissive_strength": {"emissiveStrength": 1e308}}}], "extensionsUsed": ["KHR_materials_emissive_strength"], "accessors": [{"count": 3, "type": "VEC3", "componentType": 5126, "bufferView": 0, "min": [0,0,0], "max": [1,1,1]}], "bufferViews": [{"buffer": 0, "byteLength": 36}]"#;
+    let g = write(d, "e.gltf", gltf(members));
+    let o = plie(&["render", "--scene", s(&g), "-o", s(&out)]);
+    let err = one_line_error(&o, &["e.gltf", "emissiveStrength", "finite"]);
+    assert!(!err.contains("Vec3("), "{err}");
+    // Bad base64 in a data URI.
+    let g = write(d, "b64.gltf", gltf(&members.replace("AAAAAAAAAAAAAAAAAACAPw", "AA,A")));
+    fails_with(&["render", "--scene", s(&g), "-o", s(&out)], "not valid base64");
+    // Output names without a format, or a directory.
+    fails_with(&["render", "--scene", "cornell-cube-1", "-o", s(&d.join("out"))], "no extension");
+    fails_with(&["render", "--scene", "cornell-cube-1", "-o", s(d)], "is a directory");
+    // One message for a missing output folder, in every command.
+    let missing = d.join("no/such");
+    for (cmd, name) in [("render", "o.png"), ("build", "o.plie"), ("inspect", "o.png")] {
+        let o = missing.join(name);
+        let mut args = vec![cmd, "--scene", "cornell-cube-1", "-o", s(&o)];
+        if cmd == "inspect" {
+            args.extend(["--cell", "0,0,0"]);
+        }
+        fails_with(&args, "the output folder");
+    }
+    // A negative field of view is a field-of-view error, not an unknown argument.
+    fails_with(&["render", "--scene", "cornell-cube-1", "-o", s(&out), "--fov", "-10"], "field of view");
+    // The real size limit.
+    fails_with(&["render", "--scene", "cornell-cube-1", "-o", s(&out), "--width", "4294967296"], "1..=32768");
+    fails_with(&["render", "--scene", "cornell-cube-1", "-o", s(&out), "--width", "40000"], "1..=32768");
+    // A huge number is not echoed back: on the command line (Linux caps one argument at 128 KiB)
+    // and in a scene file (1,000,000 digits).
+    let huge = "9".repeat(100_000);
+    let o = plie(&["render", "--scene", "cornell-cube-1", "-o", s(&out), "--width", &huge]);
+    let err = stderr(&o);
+    assert!(!o.status.success() && err.len() < 400, "{} bytes of error", err.len());
+    assert!(err.contains("100000 characters"), "{err}");
+    write(d, "box.mtl", BOX_MTL);
+    let obj = write(d, "huge.obj", BOX_OBJ.replace("v 1 0 1", &format!("v 1 {} 1", "9".repeat(1_000_000))));
+    let o = plie(&["render", "--scene", s(&obj), "-o", s(&out)]);
+    let err = one_line_error(&o, &["huge.obj:4", "1000000 characters"]);
+    assert!(err.len() < 400, "{} bytes of error", err.len());
+}
