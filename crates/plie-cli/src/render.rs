@@ -27,9 +27,12 @@ pub struct Args {
     output: PathBuf,
     #[command(flatten)]
     image: ImageArgs,
-    /// Visibility method: brute (every triangle), octree (SPEC mode a), bvh (modern BVH), lie (P-LIE
-    /// blockers, SPEC mode b), umbra (mode c), penumbra (mode d), grid (P-LIE face grids, ours),
-    /// embree (with the embree feature). All give the same image.
+    /// Visibility method. Exact (all give the same image): brute (every triangle), octree (SPEC mode
+    /// a), bvh (modern BVH), lie (P-LIE blockers, SPEC mode b), umbra (mode c), penumbra (mode d), grid
+    /// (P-LIE face grids, ours), embree-exact (Embree's BVH, our triangle test; embree feature).
+    /// References, NOT exact: embree (native Intel Embree 3, its own triangle test: a few shadow rays
+    /// may differ from brute; embree feature), none (no shadow test: every light sample counts as
+    /// visible; measures shading alone).
     #[arg(long, default_value = "bvh", value_name = "MODE")]
     visibility: Mode,
     /// Worker threads (default: all cores). Images do not depend on it.
