@@ -278,14 +278,14 @@ impl<'a> NativeEmbree<'a> {
         let qp: *mut Own = &mut q;
         let mut p = P::new(rays.origin, self.mask(rays.light));
         for (targets, out) in rays.targets.chunks(P::N).zip(out.chunks_mut(P::N)) {
-            let mut valid = [0 as c_int; 16];
+            let mut valid = ValidMask([0; 16]);
             for (i, &y) in targets.iter().enumerate() {
                 p.set(i, y - rays.origin);
-                valid[i] = -1;
+                valid.0[i] = -1;
             }
             // SAFETY: the scene is committed; `Own` is repr(C) and starts with its
             // `RTCIntersectContext`, so `qp` is a valid context for the filter, and lives for the call.
-            unsafe { p.occluded(valid.as_ptr(), self.rtc.0, qp.cast()) };
+            unsafe { p.occluded(valid.0.as_ptr(), self.rtc.0, qp.cast()) };
             for (i, o) in out.iter_mut().enumerate() {
                 *o = p.blocked(i);
             }
@@ -344,6 +344,10 @@ impl Visibility for NativeEmbree<'_> {
         }
     }
 }
+
+/// The valid mask of a packet (`-1`: lane valid), aligned as Embree loads it for 16 lanes.
+#[repr(C, align(64))]
+struct ValidMask([c_int; 16]);
 
 /// An SOA ray packet of `N` rays sharing their origin and mask.
 trait Lanes {
