@@ -157,6 +157,21 @@ fn render_stats_and_json_report_how_shadow_rays_were_answered() {
 }
 
 #[test]
+fn none_answers_every_shadow_ray_unoccluded_and_its_help_says_it_is_not_exact() {
+    let o = plie(&["render", "--help"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let help = String::from_utf8_lossy(&o.stdout).split_whitespace().collect::<Vec<_>>().join(" ");
+    assert!(help.contains("References, NOT exact:"), "{help}");
+    assert!(help.contains("none (no shadow test: every light sample counts as visible"), "{help}");
+    let dir = tempfile::tempdir().unwrap();
+    let (none, _) = render_json_and_stats(dir.path(), "none");
+    let (bvh, _) = render_json_and_stats(dir.path(), "bvh");
+    assert_eq!(none["shadow_rays"], bvh["shadow_rays"], "the same rays are shot");
+    assert!(bvh["occluded"].as_u64().unwrap() > 0, "{bvh}");
+    assert_eq!(none["occluded"].as_u64(), Some(0), "{none}");
+}
+
+#[test]
 fn render_pfm_is_identical_for_every_mode() {
     let dir = tempfile::tempdir().unwrap();
     let mut images = Vec::new();

@@ -41,6 +41,7 @@ pub mod scene;
 
 pub use error::{Error, Result};
 pub use scene::{Camera, Light, LightId, Material, MaterialId, Scene, SceneBuilder, TriId};
+pub mod compare;
 pub mod construct;
 pub mod inspect;
 pub mod lie;

@@ -19,7 +19,7 @@ pub use answer::{Answer, Answers};
 pub use brute::Brute;
 pub use bvh::BvhVisibility;
 #[cfg(feature = "embree")]
-pub use embree::{Embree, EmbreeVisibility};
+pub use embree::{exact::ExactEmbreeVisibility, native::NativeEmbree};
 pub use lie::LieVisibility;
 pub use mode::Mode;
 pub use octree::OctreeVisibility;
@@ -45,7 +45,7 @@ pub(crate) fn wall_scene() -> (crate::Scene, crate::TriId) {
 }
 
 /// A visibility method: answers shadow-ray queries exactly (but for the reference modes that say
-/// otherwise: [`Mode::None`], and native Embree).
+/// otherwise: [`Mode::None`] and native Embree, [`Mode::is_exact`]).
 pub trait Visibility: Sync {
     /// True if some triangle other than the ray's own (its origin triangle and the target light's
     /// triangles) intersects the open segment. `ctx` is the calling thread's scratch space and counters.
@@ -77,8 +77,8 @@ impl Visibility for NoVisibility {
 }
 
 /// The visibility method for `mode`, over the structures already built. Fails if `mode` needs a
-/// P-LIE and none is given. [`Mode::Embree`] (feature `embree`) builds its own Embree scene here, owned
-/// by the returned box, and fails if Embree cannot be set up.
+/// P-LIE and none is given. [`Mode::Embree`] and [`Mode::EmbreeExact`] (feature `embree`) build their own
+/// Embree scene here, owned by the returned box, and fail if Embree cannot be set up.
 pub fn for_mode<'a>(
     mode: Mode,
     scene: &'a crate::Scene,
@@ -100,7 +100,9 @@ pub fn for_mode<'a>(
             Box::new(LieVisibility::new(scene, bvh, octree, plie, mode))
         }
         #[cfg(feature = "embree")]
-        Mode::Embree => Box::new(EmbreeVisibility::new(scene)?),
+        Mode::Embree => Box::new(NativeEmbree::new(scene)?),
+        #[cfg(feature = "embree")]
+        Mode::EmbreeExact => Box::new(ExactEmbreeVisibility::new(scene)?),
         Mode::None => Box::new(NoVisibility),
     })
 }

@@ -22,9 +22,13 @@ pub enum Mode {
     /// Ours: face grids. The cell where the ray crosses the face says umbra (blocked), or which
     /// blockers to test (none: lit).
     Grid,
-    /// Intel Embree 3 proposing candidates to the shared predicate (cargo feature `embree`).
+    /// Native Intel Embree 3: its triangles, its triangle test, packets (cargo feature `embree`). The
+    /// peer a user compares against. Not exact: a few answers may differ from `brute`.
     #[cfg(feature = "embree")]
     Embree,
+    /// Intel Embree 3's BVH proposing candidates to the shared predicate (cargo feature `embree`).
+    #[cfg(feature = "embree")]
+    EmbreeExact,
     /// No shadow test at all: every shadow ray is unoccluded. Not exact: it exists to measure what
     /// shading costs without any visibility (the floor every other mode adds to).
     None,
@@ -40,16 +44,25 @@ impl Mode {
     /// them all.
     #[cfg(feature = "embree")]
     pub const EXACT: [Mode; 8] =
-        [Mode::Brute, Mode::Octree, Mode::Bvh, Mode::Lie, Mode::Umbra, Mode::Penumbra, Mode::Grid, Mode::Embree];
+        [Mode::Brute, Mode::Octree, Mode::Bvh, Mode::Lie, Mode::Umbra, Mode::Penumbra, Mode::Grid, Mode::EmbreeExact];
 
-    /// Every mode a user can choose: the exact ones and the reference `none`.
+    /// The modes that are not exact, kept as references to measure against: native Embree (feature
+    /// `embree`) and `none`.
+    #[cfg(not(feature = "embree"))]
+    pub const REFERENCE: [Mode; 1] = [Mode::None];
+    /// The modes that are not exact, kept as references to measure against: native Embree (feature
+    /// `embree`) and `none`.
+    #[cfg(feature = "embree")]
+    pub const REFERENCE: [Mode; 2] = [Mode::Embree, Mode::None];
+
+    /// Every mode a user can choose: the exact ones and the references.
     pub fn all() -> impl Iterator<Item = Mode> {
-        Mode::EXACT.into_iter().chain([Mode::None])
+        Mode::EXACT.into_iter().chain(Mode::REFERENCE)
     }
 
     /// True if the mode answers every shadow ray as `brute` does.
     pub fn is_exact(self) -> bool {
-        self != Mode::None
+        !Mode::REFERENCE.contains(&self)
     }
 
     /// The name used on the command line.
@@ -64,6 +77,8 @@ impl Mode {
             Mode::Grid => "grid",
             #[cfg(feature = "embree")]
             Mode::Embree => "embree",
+            #[cfg(feature = "embree")]
+            Mode::EmbreeExact => "embree-exact",
             Mode::None => "none",
         }
     }
