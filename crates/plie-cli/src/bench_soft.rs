@@ -48,6 +48,9 @@ pub struct Row {
     pub occluded: u64,
     /// How the (point, light) pairs were answered (P-LIE modes).
     pub lights: LightAnswers,
+    /// For the modes that are not exact (`embree`): the shadow rays whose answer differs from
+    /// `bvh`'s (exact), ray by ray.
+    pub differing: Option<u64>,
 }
 
 /// Everything measured.
@@ -164,6 +167,13 @@ pub fn run(scenes: &[String], out: &Path, runs: usize, quiet: bool) -> Result<()
                     }
                 }
                 let stats = last.expect("one run");
+                let differing = match col {
+                    Column::Mode(m) if m != Mode::None && !m.is_exact() => {
+                        let bvh_vis = visibility::for_mode(Mode::Bvh, &scene, &bvh, &octree, None)?;
+                        Some(plie::compare::answer_diff(&scene, hits, vis.as_ref(), bvh_vis.as_ref(), n, 1).differing)
+                    }
+                    _ => None,
+                };
                 rows.push(Row {
                     scene: label.clone(),
                     mode: col.name(),
@@ -173,6 +183,7 @@ pub fn run(scenes: &[String], out: &Path, runs: usize, quiet: bool) -> Result<()
                     rays: stats.shadow_rays,
                     occluded: stats.occluded,
                     lights: stats.lights,
+                    differing,
                 });
             }
         }
@@ -250,6 +261,18 @@ pub fn report(r: &SoftResults) -> String {
             let ratio: Vec<String> =
                 modes.iter().map(|m| sum(m, n).map_or("-".into(), |t| format!("{:.2}", t / e))).collect();
             let _ = writeln!(s, "| ratio to embree | {} |", ratio.join(" | "));
+        }
+        for row in r.rows.iter().filter(|x| x.shadow_rays == n) {
+            if let Some(d) = row.differing {
+                let _ = writeln!(
+                    s,
+                    "- `{}` on {}: {d} of {} shadow rays answered otherwise than `bvh` (exact): {:.2e}.",
+                    row.mode,
+                    row.scene,
+                    row.rays,
+                    d as f64 / row.rays.max(1) as f64
+                );
+            }
         }
         let _ = writeln!(s);
         // Whole answers of the P-LIE modes.
