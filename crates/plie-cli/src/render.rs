@@ -33,19 +33,19 @@ pub struct Args {
     image: ImageArgs,
     #[command(flatten)]
     path: PathArgs,
-    /// How shadow rays are answered. Every mode but `none` gives the same image, bit for bit; they
-    /// differ in speed. `brute`: test every triangle (the reference; slow). `octree`: walk the octree's
-    /// cells along the ray. `bvh`: a bounding volume hierarchy, the fastest without preprocessing.
-    /// `lie`: a P-LIE (built first, or read with --plie) lists, per cell face and light, the triangles
-    /// that can block the light; test only those. `umbra`: as `lie`, and a ray crossing the face in the
-    /// region the light cannot reach at all is dark without a test. `penumbra`: as `umbra`, and a ray
-    /// crossing the face where nothing blocks the light is lit without a test. `grid`: a grid on each
-    /// face says dark, lit, or which few blockers to test (the fastest P-LIE mode). `embree-exact`:
-    /// Embree's BVH proposing candidates to plie's own triangle test (exact). References, NOT exact:
-    /// `none` (no shadows at all; a lower bound on shading time) and `embree` (native Intel Embree 3
-    /// with its own triangle test: a few shadow rays may differ from `brute`). The two Embree modes need
-    /// a plie built with `--features embree`. Default: `bvh`; with --plie, the fastest mode the file
-    /// supports.
+    /// How shadow rays are answered. Every mode but `none` and `embree` gives the same image, bit for
+    /// bit; they differ in speed. `brute`: test every triangle (the reference; slow). `octree`: walk the
+    /// octree's cells along the ray. `bvh`: a bounding volume hierarchy, the fastest without
+    /// preprocessing. `lie`: a P-LIE (built first, or read with --plie) lists, per cell face and light,
+    /// the triangles that can block the light; test only those. `umbra`: as `lie`, and a ray crossing
+    /// the face in the region the light cannot reach at all is dark without a test. `penumbra`: as
+    /// `umbra`, and a ray crossing the face where nothing blocks the light is lit without a test.
+    /// `grid`: a grid on each face says dark, lit, or which few blockers to test (the fastest P-LIE
+    /// mode). `embree-exact`: Embree's BVH proposing candidates to plie's own triangle test (exact).
+    /// References, NOT exact: `none` (no shadow test: every light sample counts as visible; a lower
+    /// bound on shading time) and `embree` (native Intel Embree 3 with its own triangle test: a few
+    /// shadow rays may differ from `brute`). The two Embree modes need a plie built with `--features
+    /// embree`. Default: `bvh`; with --plie, the fastest mode the file supports.
     #[arg(long, value_name = "MODE")]
     visibility: Option<Mode>,
     /// Worker threads (default: all cores). Images do not depend on it.

@@ -162,7 +162,7 @@ fn none_answers_every_shadow_ray_unoccluded_and_its_help_says_it_is_not_exact() 
     assert!(o.status.success(), "{}", stderr(&o));
     let help = String::from_utf8_lossy(&o.stdout).split_whitespace().collect::<Vec<_>>().join(" ");
     assert!(help.contains("References, NOT exact:"), "{help}");
-    assert!(help.contains("none (no shadow test: every light sample counts as visible"), "{help}");
+    assert!(help.contains("`none` (no shadow test: every light sample counts as visible"), "{help}");
     let dir = tempfile::tempdir().unwrap();
     let (none, _) = render_json_and_stats(dir.path(), "none");
     let (bvh, _) = render_json_and_stats(dir.path(), "bvh");
