@@ -8,7 +8,7 @@ use plie::render::path::{Nee, PathSettings};
 /// Which estimator renders the image.
 #[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Integrator {
-    /// Direct light only (SPEC §2): K x K regular eye rays per pixel, N shadow rays per light each.
+    /// Direct light only: K x K regular eye rays per pixel, N shadow rays per light each.
     Direct,
     /// Path tracing: global illumination with next-event estimation through the visibility mode.
     Path,
@@ -26,7 +26,8 @@ pub enum NeeArg {
 /// Options of the estimator.
 #[derive(clap::Args, Clone, Debug)]
 pub struct PathArgs {
-    /// `direct` (direct light, as the thesis) or `path` (global illumination).
+    /// `direct` (direct light only, light -> surface -> eye) or `path` (global illumination: light also
+    /// bounces between surfaces).
     #[arg(long, value_enum, default_value_t = Integrator::Direct)]
     pub integrator: Integrator,
     /// Path: longest path, counted as Mitsuba 3's `max_depth`: 1 is emission seen directly, 2 direct
