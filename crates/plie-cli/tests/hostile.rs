@@ -93,8 +93,8 @@ fn coincident_triangles_render_quickly_in_bounded_memory() {
 /// built over 401 identical boxes is deeper than its 32-entry traversal stack; the test profile's
 /// debug assertions catch it in `CwBvh::validate`. Not fixed on this branch: see docs/robustness.md.
 #[test]
-#[ignore = "obvhs builds a BVH deeper than its traversal stack over 401 identical boxes"]
-fn four_hundred_coincident_triangles() {
+#[ignore = "known bug, not in the exhaustive tier (hand_run_): obvhs builds a BVH deeper than its traversal stack over 401 identical boxes"]
+fn hand_run_four_hundred_coincident_triangles() {
     render_copies(400);
 }
 
