@@ -242,15 +242,7 @@ impl Tracer<'_> {
             let t = Instant::now();
             self.vis.occluded_light(&rays, occluded, &mut s.ctx);
             s.stats.shadow_seconds += t.elapsed().as_secs_f64();
-            s.ctx.stats.shadow_rays += m as u64;
-            let mut sum = 0.0f32;
-            for (w, &o) in s.weights.iter().zip(occluded.iter()) {
-                if o {
-                    s.ctx.stats.occluded += 1;
-                } else {
-                    sum += w;
-                }
-            }
+            let sum = super::shade::unoccluded_sum(&s.weights, occluded, &mut s.ctx.stats);
             l += light.radiance * albedo * FRAC_1_PI * (light.area / (n * p_select) * sum);
         }
         l

@@ -71,6 +71,21 @@ fn geometry_terms(x: Vec3, n: Vec3, nl: Vec3, points: &[Vec3], terms: &mut Vec<f
     }));
 }
 
+/// The sum, in sample order, of the `weights` of the rays not `occluded`; counts the rays and the
+/// occluded ones in `stats`. Shared by direct light and the path tracer's next-event estimation.
+pub(crate) fn unoccluded_sum(weights: &[f32], occluded: &[bool], stats: &mut QueryStats) -> f32 {
+    stats.shadow_rays += occluded.len() as u64;
+    let mut sum = 0.0f32;
+    for (w, &o) in weights.iter().zip(occluded) {
+        if o {
+            stats.occluded += 1;
+        } else {
+            sum += w;
+        }
+    }
+    sum
+}
+
 /// Radiance toward the eye at one hit: emission (front side only) plus direct lighting from every
 /// light. `stream` identifies the eye ray (pixel and sub-ray index) for the random streams.
 ///
@@ -114,15 +129,7 @@ pub fn shade_hit(
             LightRays { origin: x, origin_tri: hit.tri, leaf: hit.leaf, light: LightId(i as u32), targets: &s.targets };
         let occluded = &mut s.occluded[..m];
         vis.occluded_light(&rays, occluded, &mut s.ctx);
-        s.ctx.stats.shadow_rays += m as u64;
-        let mut sum = 0.0f32;
-        for (w, &o) in s.weights.iter().zip(occluded.iter()) {
-            if o {
-                s.ctx.stats.occluded += 1;
-            } else {
-                sum += w;
-            }
-        }
+        let sum = unoccluded_sum(&s.weights, occluded, &mut s.ctx.stats);
         l += light.radiance * f_r * (light.area / n_samples as f32 * sum);
     }
     l
