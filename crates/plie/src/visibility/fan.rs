@@ -140,6 +140,15 @@ pub struct Fan {
     /// Per active lane: the watertight test's `1 / d[kz]`, and its axis `kz`.
     asz: Vec<f32>,
     akz: Vec<u32>,
+    /// Per active lane: the inverse direction for box tests ([`inverse`]).
+    aix: Vec<f32>,
+    aiy: Vec<f32>,
+    aiz: Vec<f32>,
+    /// Per ray: the inverse direction for box tests.
+    invs: Vec<Vec3>,
+    /// The lane masks of a walk down a box hierarchy ([`Fan::narrow`]): [`WALK_LEVELS`] masks of
+    /// `open.len()` words each.
+    masks: Vec<u64>,
     /// Per ray: the watertight test's axis `kz` (the largest component of `d`) and `1 / d[kz]`.
     kzs: Vec<u8>,
     szs: Vec<f32>,
@@ -162,8 +171,10 @@ impl Fan {
         self.lens.clear();
         self.kzs.clear();
         self.szs.clear();
+        self.invs.clear();
         for y in rays.targets {
             let d = *y - x;
+            self.invs.push(inverse(d));
             self.dirs.push(d);
             self.lens.push(d.length());
             // As `RayTest::new` chooses it.
@@ -185,7 +196,16 @@ impl Fan {
 
     /// Makes the rays `k` with `want(k)` the active ones.
     pub fn select(&mut self, want: impl Fn(usize) -> bool) {
-        for v in [&mut self.ax, &mut self.ay, &mut self.az, &mut self.al, &mut self.asz] {
+        for v in [
+            &mut self.ax,
+            &mut self.ay,
+            &mut self.az,
+            &mut self.al,
+            &mut self.asz,
+            &mut self.aix,
+            &mut self.aiy,
+            &mut self.aiz,
+        ] {
             v.clear();
         }
         self.idx.clear();
@@ -200,11 +220,24 @@ impl Fan {
                 self.al.push(self.lens[k]);
                 self.asz.push(self.szs[k]);
                 self.akz.push(u32::from(self.kzs[k]));
+                let i = self.invs[k];
+                self.aix.push(i.x);
+                self.aiy.push(i.y);
+                self.aiz.push(i.z);
             }
         }
         let m = self.idx.len();
         let padded = m.div_ceil(LANES) * LANES;
-        for v in [&mut self.ax, &mut self.ay, &mut self.az, &mut self.al, &mut self.asz] {
+        for v in [
+            &mut self.ax,
+            &mut self.ay,
+            &mut self.az,
+            &mut self.al,
+            &mut self.asz,
+            &mut self.aix,
+            &mut self.aiy,
+            &mut self.aiz,
+        ] {
             v.resize(padded, 0.0);
         }
         self.akz.resize(padded, 0);
@@ -216,7 +249,70 @@ impl Fan {
         }
         self.maybe.clear();
         self.maybe.resize(words, 0);
+        self.masks.clear();
+        self.masks.resize(words * WALK_LEVELS, 0);
         self.live = m;
+    }
+
+    /// One step down a box hierarchy walked by all active rays at once: mask `level` becomes the
+    /// open lanes of mask `level - 1` (of all open lanes, for level 0) whose segments meet the box
+    /// `b`. Returns whether any does. The test is the slab test of [`crate::geometry::Segment::clip`],
+    /// eight lanes at a time; it never drops a lane whose segment meets `b`. Counts a box test per
+    /// lane tested.
+    #[inline]
+    pub fn narrow(&mut self, b: &Aabb, level: usize, ctx: &mut QueryCtx) -> bool {
+        let w = self.open.len();
+        let (above, rest) = self.masks.split_at_mut(level * w);
+        let from = if level == 0 { &self.open[..] } else { &above[(level - 1) * w..] };
+        let to = &mut rest[..w];
+        let lanes = BoxLanes { ix: &self.aix, iy: &self.aiy, iz: &self.aiz };
+        let (lo, hi) = (b.min - self.origin, b.max - self.origin);
+        let mut any = 0;
+        for i in 0..w {
+            let f = from[i] & self.open[i];
+            ctx.stats.box_tests += u64::from(f.count_ones());
+            to[i] = if f == 0 { 0 } else { meets_box(lo, hi, &lanes, i * 64, f) };
+            any |= to[i];
+        }
+        any != 0
+    }
+
+    /// Mask `level` becomes all open lanes (for a hierarchy whose top box is not worth testing).
+    #[inline]
+    pub fn narrow_to_open(&mut self, level: usize) {
+        let w = self.open.len();
+        self.masks[level * w..(level + 1) * w].copy_from_slice(&self.open);
+    }
+
+    /// The watertight test of triangle `t` for each open lane of mask `level`: each ray it blocks
+    /// gets `out[k]` set and is closed. The caller has excluded the rays' own triangles.
+    #[inline]
+    pub fn test_level(
+        &mut self,
+        scene: &Scene,
+        rays: &LightRays,
+        t: TriId,
+        level: usize,
+        out: &mut [bool],
+        ctx: &mut QueryCtx,
+    ) {
+        let w = self.open.len();
+        let tri = &scene.triangles[t.idx()];
+        for i in 0..w {
+            let mut bits = self.masks[level * w + i] & self.open[i];
+            while bits != 0 {
+                let j = i * 64 + bits.trailing_zeros() as usize;
+                bits &= bits - 1;
+                let k = self.idx[j] as usize;
+                let ray = *self.rays[k].get_or_insert_with(|| rays.ray(k));
+                ctx.stats.triangle_tests += 1;
+                if ray.test.hit(tri).is_some() {
+                    self.open[i] &= !(1u64 << (j % 64));
+                    self.live -= 1;
+                    out[k] = true;
+                }
+            }
+        }
     }
 
     /// Active rays not yet found occluded.
@@ -271,6 +367,96 @@ impl Fan {
             }
         }
     }
+}
+
+/// Depth of the box hierarchies walked by [`Fan::narrow`]: groups, chunks, triangles.
+const WALK_LEVELS: usize = 3;
+
+/// The inverse of a direction for the slab test, with a non-finite component (a zero or tiny
+/// component) replaced by `±f32::MAX`. A product with it is then never NaN, and the slab it gives
+/// is the whole line where the box's slab holds the origin and empty (up to the segment's tiny
+/// motion along that axis, which is far below the boxes' growth by the construction tolerance)
+/// where it does not, as [`crate::geometry::Segment`]'s parallel case decides.
+#[inline]
+fn inverse(d: Vec3) -> Vec3 {
+    let i = d.recip();
+    Vec3::select(i.is_finite_mask(), i, Vec3::splat(f32::MAX).copysign(i))
+}
+
+/// The active rays' inverse directions in lanes.
+struct BoxLanes<'a> {
+    ix: &'a [f32],
+    iy: &'a [f32],
+    iz: &'a [f32],
+}
+
+/// The bits of `within` (the word of lanes `base..base + 64`) whose segments (origin at the
+/// fan's apex, parameter range `[SEGMENT_EPS, 1 - SEGMENT_EPS]`) meet the box `[lo, hi]` given
+/// relative to the apex.
+#[inline]
+fn meets_box(lo: Vec3, hi: Vec3, lanes: &BoxLanes, base: usize, within: u64) -> u64 {
+    #[cfg(target_arch = "x86_64")]
+    if std::arch::is_x86_feature_detected!("avx2") {
+        // SAFETY: AVX2 is available (checked above); the lane arrays are padded to whole blocks.
+        return unsafe { meets_box_avx(lo, hi, lanes, base, within) };
+    }
+    let mut out = 0;
+    let mut bits = within;
+    while bits != 0 {
+        let b = bits.trailing_zeros() as usize;
+        bits &= bits - 1;
+        let j = base + b;
+        let inv = Vec3::new(lanes.ix[j], lanes.iy[j], lanes.iz[j]);
+        let (a, c) = (lo * inv, hi * inv);
+        let t0 = a.min(c).max_element().max(SEGMENT_EPS);
+        let t1 = a.max(c).min_element().min(1.0 - SEGMENT_EPS);
+        if t0 <= t1 {
+            out |= 1 << b;
+        }
+    }
+    out
+}
+
+/// [`meets_box`], eight lanes at a time (blocks of lanes with no bit in `within` are skipped).
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx,avx2")]
+unsafe fn meets_box_avx(lo: Vec3, hi: Vec3, lanes: &BoxLanes, base: usize, within: u64) -> u64 {
+    use std::arch::x86_64::*;
+    let sp = |v: f32| _mm256_set1_ps(v);
+    let (lx, ly, lz, hx, hy, hz) = (sp(lo.x), sp(lo.y), sp(lo.z), sp(hi.x), sp(hi.y), sp(hi.z));
+    let (t_min, t_max) = (sp(SEGMENT_EPS), sp(1.0 - SEGMENT_EPS));
+    let n = lanes.ix.len().min(lanes.iy.len()).min(lanes.iz.len());
+    let mut out = 0u64;
+    let mut block = 0;
+    while block < 8 {
+        let byte = (within >> (block * 8)) & 0xff;
+        let j = base + block * LANES;
+        if byte != 0 && j + LANES <= n {
+            // SAFETY: j + LANES <= n <= every array's length.
+            let (ix, iy, iz) = unsafe {
+                (
+                    _mm256_loadu_ps(lanes.ix.as_ptr().add(j)),
+                    _mm256_loadu_ps(lanes.iy.as_ptr().add(j)),
+                    _mm256_loadu_ps(lanes.iz.as_ptr().add(j)),
+                )
+            };
+            let (ax, cx) = (_mm256_mul_ps(lx, ix), _mm256_mul_ps(hx, ix));
+            let (ay, cy) = (_mm256_mul_ps(ly, iy), _mm256_mul_ps(hy, iy));
+            let (az, cz) = (_mm256_mul_ps(lz, iz), _mm256_mul_ps(hz, iz));
+            let t0 = _mm256_max_ps(
+                _mm256_max_ps(_mm256_min_ps(ax, cx), _mm256_min_ps(ay, cy)),
+                _mm256_max_ps(_mm256_min_ps(az, cz), t_min),
+            );
+            let t1 = _mm256_min_ps(
+                _mm256_min_ps(_mm256_max_ps(ax, cx), _mm256_max_ps(ay, cy)),
+                _mm256_min_ps(_mm256_max_ps(az, cz), t_max),
+            );
+            let m = _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(t0, t1)) as u64;
+            out |= (m & byte) << (block * 8);
+        }
+        block += 1;
+    }
+    out
 }
 
 /// The active rays in lanes (see [`Fan`]).
