@@ -592,4 +592,6 @@ pub struct LightScratch {
     pub list: Vec<u32>,
     /// The distinct blocker lists of the current (point, light): the mode's own keys.
     pub lists: Vec<u32>,
+    /// The light's footprints on the leaf's faces.
+    pub feet: Vec<super::footprint::FaceFootprint>,
 }

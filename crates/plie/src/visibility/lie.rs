@@ -19,7 +19,8 @@
 //! blocker tests and own-leaf tests (`plie render --stats`).
 
 use super::bvh::{segment_occluded, Bvh};
-use super::fan::Fan;
+use super::fan::{Fan, LightScratch, Pyramid};
+use super::footprint::{footprints, FaceFootprint};
 use super::leaf_voxels::LeafVoxels;
 use super::query::SEGMENT_EPS;
 use super::{blocks, Answer, LightRays, Mode, OctreeVisibility, QueryCtx, ShadowRay, Visibility};
@@ -130,6 +131,41 @@ pub struct LieVisibility<'a> {
     own: Vec<(u32, u32)>,
     own_tris: Vec<TriId>,
     own_boxes: ListBoxes,
+    /// In `grid`: per record, where its grid's tables start in `sat` (`u32::MAX`: no grid).
+    sat_start: Vec<u32>,
+    /// Summed-area tables of each face grid, `(res + 1)^2` pairs each: the number of cells that are
+    /// not lit (umbra, scene or a non-empty list) and of cells that are not umbra, in the cells
+    /// `[0, i) x [0, j)`. A footprint's cells are then counted in four lookups.
+    sat: Vec<[u32; 2]>,
+}
+
+/// Summed-area tables of the face grids of `plie` (see [`LieVisibility::sat`]).
+fn grid_tables(plie: &Plie) -> (Vec<u32>, Vec<[u32; 2]>) {
+    let mut start = Vec::with_capacity(plie.grids.len());
+    let mut sat = Vec::new();
+    for grid in &plie.grids {
+        if grid.res == 0 {
+            start.push(u32::MAX);
+            continue;
+        }
+        start.push(sat.len() as u32);
+        let g = grid.res as usize;
+        let base = sat.len();
+        sat.resize(base + (g + 1) * (g + 1), [0, 0]);
+        for j in 0..g {
+            for i in 0..g {
+                let (not_lit, not_umbra) = match plie.cell(grid, j * g + i) {
+                    Cell::Umbra => (1, 0),
+                    Cell::Scene => (1, 1),
+                    Cell::Blockers(l) => (u32::from(!l.is_empty()), 1),
+                };
+                let at = |i: usize, j: usize| base + j * (g + 1) + i;
+                let (a, b, c) = (sat[at(i, j + 1)], sat[at(i + 1, j)], sat[at(i, j)]);
+                sat[at(i + 1, j + 1)] = [a[0] + b[0] - c[0] + not_lit, a[1] + b[1] - c[1] + not_umbra];
+            }
+        }
+    }
+    (start, sat)
 }
 
 impl<'a> LieVisibility<'a> {
@@ -156,6 +192,7 @@ impl<'a> LieVisibility<'a> {
             own.push((start as u32, (own_tris.len() - start) as u32));
         }
         let own_boxes = ListBoxes::new(own.iter().copied(), &own_tris, &tri_boxes);
+        let (sat_start, sat) = if mode == Mode::Grid { grid_tables(plie) } else { (Vec::new(), Vec::new()) };
         LieVisibility {
             scene,
             octree,
@@ -170,6 +207,64 @@ impl<'a> LieVisibility<'a> {
             own,
             own_tris,
             own_boxes,
+            sat_start,
+            sat,
+        }
+    }
+
+    /// The whole light at once, from its footprints on the faces of `leaf` ([`footprints`]), if
+    /// they decide it: `Some(true)` if every sample's ray is occluded (each leaves the leaf through
+    /// a face without a record or through umbra cells), `Some(false)` if no blocker list can hit
+    /// any of them (every footprint lies in lit cells, or on records with empty lists) so that only
+    /// the leaf's own triangles remain to test, `None` otherwise.
+    fn whole_light(
+        &self,
+        leaf: LeafId,
+        bounds: &Aabb,
+        rays: &LightRays,
+        feet: &mut Vec<FaceFootprint>,
+    ) -> Option<bool> {
+        let light = &self.scene.lights[rays.light.idx()];
+        let all_exit = footprints(bounds, rays.origin, &light.vertices, SEGMENT_EPS, feet);
+        let (mut lit, mut umbra) = (true, all_exit);
+        for fp in feet.iter() {
+            let Some(ri) = self.plie.record_id(leaf, fp.face, rays.light) else {
+                lit = false;
+                continue;
+            };
+            let record = &self.plie.records[ri];
+            match self.sat_start.get(ri).copied().filter(|&s| s != u32::MAX) {
+                Some(start) => {
+                    let g = self.plie.grids[ri].res as usize;
+                    let k = fp.face.axis();
+                    let (u, v) = grid::face_axes(k);
+                    let cell = |x: f64, axis: usize| {
+                        let (lo, hi) = (bounds.min[axis] as f64, bounds.max[axis] as f64);
+                        (((x - lo) / (hi - lo) * g as f64).max(0.0) as usize).min(g - 1)
+                    };
+                    let (i0, i1) = (cell(fp.rect[0], u), cell(fp.rect[1], u));
+                    let (j0, j1) = (cell(fp.rect[2], v), cell(fp.rect[3], v));
+                    let at = |i: usize, j: usize| self.sat[start as usize + j * (g + 1) + i];
+                    let count =
+                        |w: usize| at(i1 + 1, j1 + 1)[w] + at(i0, j0)[w] - at(i0, j1 + 1)[w] - at(i1 + 1, j0)[w];
+                    lit &= count(0) == 0;
+                    umbra &= count(1) == 0;
+                }
+                None => {
+                    lit &= record.kind == RecordKind::Listed && record.blockers_len == 0;
+                    umbra = false;
+                }
+            }
+            if !lit && !umbra {
+                return None;
+            }
+        }
+        if umbra {
+            Some(true)
+        } else if lit {
+            Some(false)
+        } else {
+            None
         }
     }
 
@@ -337,6 +432,25 @@ impl Visibility for LieVisibility<'_> {
         let n = rays.targets.len();
         let mut scratch = std::mem::take(&mut ctx.light);
         let sc = &mut scratch;
+        let bounds = self.octree.leaf_bounds(leaf);
+        match self.whole_light(leaf, &bounds, rays, &mut sc.feet) {
+            Some(true) => {
+                out.fill(true);
+                ctx.stats.lights.queries += 1;
+                ctx.stats.lights.whole_umbra += 1;
+                for _ in 0..n {
+                    ctx.stats.answered(Answer::Umbra, true);
+                }
+                ctx.light = scratch;
+                return;
+            }
+            Some(false) => {
+                self.own_only(leaf, rays, sc, out, ctx);
+                ctx.light = scratch;
+                return;
+            }
+            None => {}
+        }
         sc.fan.set(rays);
         sc.path.clear();
         sc.path.resize(n, path::LIT);
@@ -344,7 +458,6 @@ impl Visibility for LieVisibility<'_> {
         sc.list.resize(n, u32::MAX);
         sc.lists.clear();
         out.fill(false);
-        let bounds = self.octree.leaf_bounds(leaf);
         let x = rays.origin;
         // Per face: the record (`None`: no record), looked up once.
         let mut records: [Option<Option<usize>>; 6] = [None; 6];
@@ -521,6 +634,51 @@ impl LieVisibility<'_> {
             let ri = key as usize;
             self.record_boxes.of(ri, self.plie.blockers_of(&self.plie.records[ri]))
         }
+    }
+
+    /// A light whose footprints lie in lit cells only: every sample is lit unless a triangle of the
+    /// leaf itself blocks it. Those meeting the pyramid (usually none) are tested as a fan.
+    fn own_only(&self, leaf: LeafId, rays: &LightRays, sc: &mut LightScratch, out: &mut [bool], ctx: &mut QueryCtx) {
+        out.fill(false);
+        ctx.stats.lights.queries += 1;
+        let margin = self.pad * 10.0;
+        sc.fan.pyramid.set(rays.origin, &self.scene.lights[rays.light.idx()], margin);
+        let (start, len) = self.own[leaf.idx()];
+        let own = self.own_boxes.of(leaf.idx(), &self.own_tris[start as usize..(start + len) as usize]);
+        let before = ctx.stats.triangle_tests;
+        let lanes_before = ctx.stats.lane_tests;
+        if self.any_in_pyramid(rays, own, &sc.fan.pyramid, ctx) {
+            sc.fan.set(rays);
+            sc.fan.select(|_| true);
+            self.fan_list(rays, own, false, &mut sc.fan, out, ctx);
+        }
+        ctx.stats.own_leaf_tests += ctx.stats.triangle_tests - before;
+        for &o in out.iter() {
+            ctx.stats.answered(if o { Answer::OwnLeaf } else { Answer::Lit }, o);
+        }
+        if ctx.stats.lane_tests == lanes_before {
+            ctx.stats.lights.whole_lit += 1;
+        } else {
+            ctx.stats.lights.per_sample += 1;
+        }
+    }
+
+    /// True if a triangle of `list` (other than the rays' own) is not culled by `pyramid`.
+    fn any_in_pyramid(&self, rays: &LightRays, list: Chunked, pyramid: &Pyramid, ctx: &mut QueryCtx) -> bool {
+        let tri_in = |t: TriId, ctx: &mut QueryCtx| {
+            if t == rays.origin_tri || self.scene.tri_light[t.idx()] == Some(rays.light) {
+                return false;
+            }
+            ctx.stats.box_tests += 1;
+            !pyramid.culls(&self.scene.triangles[t.idx()])
+        };
+        if list.chunks.is_empty() {
+            return list.list.iter().any(|&t| tri_in(t, ctx));
+        }
+        list.list.chunks(CHUNK).zip(list.chunks).any(|(chunk, b)| {
+            ctx.stats.box_tests += 1;
+            !pyramid.culls_box(b) && chunk.iter().any(|&t| tri_in(t, ctx))
+        })
     }
 
     /// Tests the long list `list` against the fan's active rays as [`Self::any_blocks`] does ray by

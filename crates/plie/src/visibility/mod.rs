@@ -9,6 +9,7 @@ pub mod bvh;
 #[cfg(feature = "embree")]
 pub mod embree;
 pub mod fan;
+pub mod footprint;
 pub mod leaf_voxels;
 pub mod lie;
 pub mod mode;

@@ -1,0 +1,152 @@
+//! The footprint of a light on the faces of the leaf around a shaded point (issue 21): the part of
+//! each face of the leaf `c` that the segments from the point `x` to the light polygon can cross
+//! when they leave `c` (SPEC §5: a shadow ray leaves `c` through one face, and that face's record
+//! answers it). The per-light query classifies a whole light at once from these rectangles: if the
+//! face-grid cells (or records) under every footprint are lit, or all umbra, every sample's answer is
+//! known without looking at the samples one by one.
+//!
+//! Conservative by construction: each rectangle is grown by a margin far above the rounding of the
+//! per-ray exit point (`x + d t_exit`, in `f32`), and a face whose plane the light straddles gets the
+//! whole face.
+
+use glam::{DVec3, Vec3};
+
+use crate::geometry::Aabb;
+use crate::octree::Dir;
+
+/// The footprint on one face: the face, and the rectangle `[u0, u1] x [v0, v1]` of the face's own
+/// axes (as [`crate::construct::grid::face_axes`] orders them), in world units, clamped to the face.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FaceFootprint {
+    /// The face of the leaf.
+    pub face: Dir,
+    /// `[u0, u1, v0, v1]`.
+    pub rect: [f64; 4],
+}
+
+/// The footprints of the segments from `x` (inside `bounds`) to the convex polygon `light` on the
+/// faces of `bounds`, into `out`. Returns whether every such segment certainly leaves the box before
+/// its parameter `1 - 2 eps` (`eps` the segments' end tolerance), that is, whether no sample's ray
+/// can end inside the leaf.
+pub fn footprints(bounds: &Aabb, x: Vec3, light: &[Vec3], eps: f32, out: &mut Vec<FaceFootprint>) -> bool {
+    out.clear();
+    let xd = x.as_dvec3();
+    // The margin: relative to the coordinates involved, far above f32 rounding (~6e-8 relative).
+    let scale = light.iter().fold(x.abs().max_element(), |m, v| m.max(v.abs().max_element())) as f64;
+    let margin = 1e-5 * scale.max(f64::MIN_POSITIVE);
+    let (lo, hi) = (bounds.min.as_dvec3(), bounds.max.as_dvec3());
+    let mut all_exit = false;
+    for k in 0..3 {
+        let (u, v) = ((k + 1) % 3, (k + 2) % 3);
+        for positive in [false, true] {
+            let w = if positive { hi[k] } else { lo[k] };
+            // Signed distance beyond the face plane, away from x.
+            let beyond = |p: DVec3| if positive { p[k] - w } else { w - p[k] };
+            if light.iter().all(|p| beyond(p.as_dvec3()) <= margin) {
+                // No light point lies clearly beyond this plane: a segment may still reach it
+                // within rounding; it is counted as crossing the whole face only if some vertex
+                // is not clearly inside.
+                if light.iter().all(|p| beyond(p.as_dvec3()) < -margin) {
+                    continue;
+                }
+                out.push(FaceFootprint { face: Dir::from_axis(k, positive), rect: [lo[u], hi[u], lo[v], hi[v]] });
+                continue;
+            }
+            let strictly = light.iter().all(|p| beyond(p.as_dvec3()) > margin);
+            let rect = if strictly {
+                // Every segment crosses the plane: the cross-section is the projection of the polygon.
+                let h = beyond(xd).abs();
+                let mut r = [f64::INFINITY, f64::NEG_INFINITY, f64::INFINITY, f64::NEG_INFINITY];
+                for p in light {
+                    let p = p.as_dvec3();
+                    // The point of the segment x -> p on the plane.
+                    let s = h / (h + beyond(p));
+                    let q = xd + (p - xd) * s;
+                    r = [r[0].min(q[u]), r[1].max(q[u]), r[2].min(q[v]), r[3].max(q[v])];
+                }
+                // Every segment leaves the box at the latest where it crosses this plane, at
+                // parameter s <= max over vertices (the parameter is monotone along the polygon's
+                // points, being h / (h + beyond) with beyond affine).
+                let s_max = light.iter().map(|p| h / (h + beyond(p.as_dvec3()))).fold(0.0, f64::max);
+                if s_max < 1.0 - 4.0 * eps as f64 {
+                    all_exit = true;
+                }
+                [
+                    (r[0] - margin).max(lo[u]),
+                    (r[1] + margin).min(hi[u]),
+                    (r[2] - margin).max(lo[v]),
+                    (r[3] + margin).min(hi[v]),
+                ]
+            } else {
+                [lo[u], hi[u], lo[v], hi[v]]
+            };
+            if rect[0] <= rect[1] && rect[2] <= rect[3] {
+                out.push(FaceFootprint { face: Dir::from_axis(k, positive), rect });
+            }
+        }
+    }
+    all_exit
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Random segments from a point in a box to a light polygon cross a face only inside that
+    /// face's footprint, and leave the box when the footprints say all do.
+    #[test]
+    fn footprints_hold_every_exit_point() {
+        let bounds = Aabb { min: Vec3::new(0.0, 0.0, 0.0), max: Vec3::new(1.0, 1.0, 1.0) };
+        let mut out = Vec::new();
+        let mut state = 7u64;
+        let mut rnd = || {
+            state = crate::render::sampler::mix64(state);
+            (state >> 40) as f32 / (1u64 << 24) as f32
+        };
+        for case in 0..2000 {
+            let x = Vec3::new(rnd(), rnd(), rnd());
+            let c = Vec3::new(rnd() * 6.0 - 2.5, rnd() * 3.0 + 0.2 + (case % 3) as f32, rnd() * 6.0 - 2.5);
+            let (e1, e2) = (Vec3::new(rnd(), 0.0, rnd() * 0.3), Vec3::new(rnd() * 0.3, rnd() * 0.2, rnd()));
+            let light = [c, c + e1, c + e1 + e2, c + e2];
+            let all_exit = footprints(&bounds, x, &light, 1e-4, &mut out);
+            for _ in 0..64 {
+                let (a, b) = (rnd(), rnd());
+                let y = c + e1 * a + e2 * b;
+                let d = y - x;
+                // The exit face as the query finds it.
+                let mut best = (1.0 - 1e-4f32, None);
+                for k in 0..3 {
+                    let (t, positive) = if d[k] > 0.0 {
+                        ((bounds.max[k] - x[k]) / d[k], true)
+                    } else if d[k] < 0.0 {
+                        ((bounds.min[k] - x[k]) / d[k], false)
+                    } else {
+                        continue;
+                    };
+                    if t < best.0 {
+                        best = (t, Some(Dir::from_axis(k, positive)));
+                    }
+                }
+                let Some(face) = best.1 else {
+                    assert!(!all_exit, "case {case}: a ray ends inside the box");
+                    continue;
+                };
+                let f = x + d * best.0;
+                let k = face.axis();
+                let (u, v) = ((k + 1) % 3, (k + 2) % 3);
+                let fp = out.iter().find(|p| p.face == face).unwrap_or_else(|| panic!("case {case}: {face:?} missing"));
+                let (fu, fv) = (f[u] as f64, f[v] as f64);
+                assert!(
+                    fp.rect[0] <= fu.max(0.0) && fu.min(1.0) <= fp.rect[1],
+                    "case {case}: {fu} outside {:?}",
+                    fp.rect
+                );
+                assert!(
+                    fp.rect[2] <= fv.max(0.0) && fv.min(1.0) <= fp.rect[3],
+                    "case {case}: {fv} outside {:?}",
+                    fp.rect
+                );
+            }
+        }
+    }
+}
