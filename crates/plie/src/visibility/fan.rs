@@ -369,8 +369,8 @@ impl Fan {
     }
 }
 
-/// Depth of the box hierarchies walked by [`Fan::narrow`]: groups, chunks, triangles.
-const WALK_LEVELS: usize = 3;
+/// Masks of a walk down a list's box hierarchy ([`Fan::narrow`]): one per level, and the triangles'.
+const WALK_LEVELS: usize = super::list_boxes::MAX_LEVELS + 1;
 
 /// The inverse of a direction for the slab test, with a non-finite component (a zero or tiny
 /// component) replaced by `±f32::MAX`. A product with it is then never NaN, and the slab it gives

@@ -22,86 +22,15 @@ use super::bvh::{segment_occluded, Bvh};
 use super::fan::{Fan, LightScratch, Pyramid};
 use super::footprint::{footprints, FaceFootprint};
 use super::leaf_voxels::LeafVoxels;
+use super::list_boxes::{Chunked, ListBoxes, ListVisitor};
 use super::query::SEGMENT_EPS;
 use super::{blocks, Answer, LightRays, Mode, OctreeVisibility, QueryCtx, ShadowRay, Visibility};
 use crate::construct::grid;
 use crate::construct::regions::{in_triangles, FaceFrame};
 use crate::geometry::{Aabb, Segment};
-use crate::lie::{Cell, Plie, RecordKind, CHUNK, CHUNKED_MIN};
+use crate::lie::{Cell, Plie, RecordKind};
 use crate::octree::{Dir, LeafId, Octree};
 use crate::scene::{Scene, TriId};
-
-/// The boxes of consecutive chunks of [`CHUNK`] blockers of every long list, and of groups of
-/// [`CHUNK`] chunks (SPEC §8 point 4): a ray tests a group's box, then its chunks' boxes, before the
-/// boxes of their blockers, so it skips most of a long list whose triangles lie away from it. Long
-/// lists are stored in Morton order ([`crate::geometry::morton`]), so chunks are compact. Built when
-/// the visibility is made; conservative culls, so answers do not change.
-#[derive(Default)]
-struct ListBoxes {
-    /// Per list: the index of its first chunk box in `boxes`, or `u32::MAX` for a short list.
-    first: Vec<u32>,
-    /// Chunk boxes (unions of the grown triangle boxes).
-    boxes: Vec<Aabb>,
-    /// Per list: the index of its first group box in `groups` (`u32::MAX` for a short list).
-    first_group: Vec<u32>,
-    /// Boxes of groups of [`CHUNK`] consecutive chunks.
-    groups: Vec<Aabb>,
-}
-
-impl ListBoxes {
-    /// Chunk and group boxes of the lists `ranges` (start, len) of `refs`. Ranges may repeat (grid
-    /// cells share lists): a repeated range shares its boxes.
-    fn new(ranges: impl Iterator<Item = (u32, u32)>, refs: &[TriId], tri_boxes: &[Aabb]) -> ListBoxes {
-        let mut out = ListBoxes::default();
-        let mut seen: std::collections::HashMap<u32, (u32, u32)> = std::collections::HashMap::new();
-        for (start, len) in ranges {
-            if (len as usize) < CHUNKED_MIN || start == u32::MAX {
-                out.first.push(u32::MAX);
-                out.first_group.push(u32::MAX);
-                continue;
-            }
-            let (f, g) = *seen.entry(start).or_insert_with(|| {
-                let (f, g) = (out.boxes.len(), out.groups.len());
-                let union = |it: &mut dyn Iterator<Item = Aabb>| it.reduce(Aabb::union).expect("not empty");
-                for chunk in refs[start as usize..(start + len) as usize].chunks(CHUNK) {
-                    out.boxes.push(union(&mut chunk.iter().map(|t| tri_boxes[t.idx()])));
-                }
-                for group in out.boxes[f..].chunks(CHUNK) {
-                    out.groups.push(union(&mut group.iter().copied()));
-                }
-                (f as u32, g as u32)
-            });
-            out.first.push(f);
-            out.first_group.push(g);
-        }
-        out
-    }
-
-    /// List `i` (stored at `list`) with its chunk and group boxes if it is long.
-    #[inline]
-    fn of<'s>(&'s self, i: usize, list: &'s [TriId]) -> Chunked<'s> {
-        match self.first[i] {
-            u32::MAX => Chunked { list, chunks: &[], groups: &[] },
-            f => {
-                let (f, g) = (f as usize, self.first_group[i] as usize);
-                let n = list.len().div_ceil(CHUNK);
-                Chunked { list, chunks: &self.boxes[f..f + n], groups: &self.groups[g..g + n.div_ceil(CHUNK)] }
-            }
-        }
-    }
-}
-
-/// A blocker list with, if long, the boxes of its chunks and of its groups of chunks.
-#[derive(Clone, Copy)]
-struct Chunked<'a> {
-    list: &'a [TriId],
-    chunks: &'a [Aabb],
-    groups: &'a [Aabb],
-}
-
-impl Chunked<'_> {
-    const EMPTY: Chunked<'static> = Chunked { list: &[], chunks: &[], groups: &[] };
-}
 
 /// Modes (b)-(d) and `grid`: the P-LIE's blocker lists, regions and face grids.
 ///
@@ -279,31 +208,26 @@ impl<'a> LieVisibility<'a> {
     /// the groups and chunks whose box the segment meets), and the number of triangle tests that took.
     #[inline]
     fn any_blocks(&self, seg: &Segment, ray: &ShadowRay, l: Chunked, ctx: &mut QueryCtx) -> (bool, u64) {
+        /// A ray down the hierarchy.
+        struct Ray<'v, 'a, 'c> {
+            vis: &'v LieVisibility<'a>,
+            seg: &'v Segment,
+            ray: &'v ShadowRay,
+            ctx: &'c mut QueryCtx,
+        }
+        impl ListVisitor for Ray<'_, '_, '_> {
+            #[inline]
+            fn enter(&mut self, b: &Aabb, _: usize) -> bool {
+                self.ctx.stats.box_tests += 1;
+                self.seg.clip(b).is_some()
+            }
+            #[inline]
+            fn chunk(&mut self, tris: &[TriId], _: usize) -> bool {
+                tris.iter().any(|&t| self.vis.test(self.seg, self.ray, t, self.ctx))
+            }
+        }
         let before = ctx.stats.triangle_tests;
-        let meets = |b: &Aabb, ctx: &mut QueryCtx| {
-            ctx.stats.box_tests += 1;
-            seg.clip(b).is_some()
-        };
-        // The chunks of `tris` whose boxes (`boxes`) the segment meets.
-        let scan = |tris: &[TriId], boxes: &[Aabb], ctx: &mut QueryCtx| {
-            tris.chunks(CHUNK)
-                .zip(boxes)
-                .any(|(chunk, b)| meets(b, ctx) && chunk.iter().any(|&t| self.test(seg, ray, t, ctx)))
-        };
-        let hit = if l.chunks.is_empty() {
-            l.list.iter().any(|&t| self.test(seg, ray, t, ctx))
-        } else if l.groups.len() == 1 {
-            // One group: its box would only repeat the chunks' tests.
-            scan(l.list, l.chunks, ctx)
-        } else {
-            let per_group = CHUNK * CHUNK;
-            l.groups.iter().enumerate().any(|(gi, g)| {
-                meets(g, ctx) && {
-                    let tris = &l.list[gi * per_group..l.list.len().min((gi + 1) * per_group)];
-                    scan(tris, &l.chunks[gi * CHUNK..l.chunks.len().min((gi + 1) * CHUNK)], ctx)
-                }
-            })
-        };
+        let hit = l.walk(&mut Ray { vis: self, seg, ray, ctx });
         (hit, ctx.stats.triangle_tests - before)
     }
 }
@@ -548,7 +472,7 @@ impl Visibility for LieVisibility<'_> {
             // box tests as `occluded` does per ray: a thin segment culls their chunks far better
             // than the pyramid does.
             let before = ctx.stats.triangle_tests;
-            let long = |key: u32| !self.list_of(key).chunks.is_empty();
+            let long = |key: u32| self.list_of(key).is_long();
             for (i, &key) in sc.lists.iter().enumerate() {
                 if long(key) {
                     let list_of = &sc.list;
@@ -665,20 +589,32 @@ impl LieVisibility<'_> {
 
     /// True if a triangle of `list` (other than the rays' own) is not culled by `pyramid`.
     fn any_in_pyramid(&self, rays: &LightRays, list: Chunked, pyramid: &Pyramid, ctx: &mut QueryCtx) -> bool {
-        let tri_in = |t: TriId, ctx: &mut QueryCtx| {
-            if t == rays.origin_tri || self.scene.tri_light[t.idx()] == Some(rays.light) {
-                return false;
-            }
-            ctx.stats.box_tests += 1;
-            !pyramid.culls(&self.scene.triangles[t.idx()])
-        };
-        if list.chunks.is_empty() {
-            return list.list.iter().any(|&t| tri_in(t, ctx));
+        /// The pyramid down the hierarchy.
+        struct Cull<'v, 'a, 'c> {
+            vis: &'v LieVisibility<'a>,
+            rays: &'v LightRays<'v>,
+            pyramid: &'v Pyramid,
+            ctx: &'c mut QueryCtx,
         }
-        list.list.chunks(CHUNK).zip(list.chunks).any(|(chunk, b)| {
-            ctx.stats.box_tests += 1;
-            !pyramid.culls_box(b) && chunk.iter().any(|&t| tri_in(t, ctx))
-        })
+        impl ListVisitor for Cull<'_, '_, '_> {
+            #[inline]
+            fn enter(&mut self, b: &Aabb, _: usize) -> bool {
+                self.ctx.stats.box_tests += 1;
+                !self.pyramid.culls_box(b)
+            }
+            #[inline]
+            fn chunk(&mut self, tris: &[TriId], _: usize) -> bool {
+                let (vis, rays) = (self.vis, self.rays);
+                tris.iter().any(|&t| {
+                    if t == rays.origin_tri || vis.scene.tri_light[t.idx()] == Some(rays.light) {
+                        return false;
+                    }
+                    self.ctx.stats.box_tests += 1;
+                    !self.pyramid.culls(&vis.scene.triangles[t.idx()])
+                })
+            }
+        }
+        list.walk(&mut Cull { vis: self, rays, pyramid, ctx })
     }
 
     /// Tests the long list `list` against the fan's active rays as [`Self::any_blocks`] does ray by
@@ -687,31 +623,35 @@ impl LieVisibility<'_> {
     /// until the ray is found occluded. All active rays go down the hierarchy together, eight per
     /// box test ([`Fan::narrow`]).
     fn walk_list(&self, rays: &LightRays, list: Chunked, fan: &mut Fan, out: &mut [bool], ctx: &mut QueryCtx) {
-        let per_group = CHUNK * CHUNK;
-        for (gi, group) in list.list.chunks(per_group).enumerate() {
-            if fan.live() == 0 {
-                return;
+        /// The fan's active rays down the hierarchy.
+        struct Rays<'v, 'a, 'c> {
+            vis: &'v LieVisibility<'a>,
+            rays: &'v LightRays<'v>,
+            fan: &'c mut Fan,
+            out: &'c mut [bool],
+            ctx: &'c mut QueryCtx,
+        }
+        impl ListVisitor for Rays<'_, '_, '_> {
+            #[inline]
+            fn enter(&mut self, b: &Aabb, depth: usize) -> bool {
+                self.fan.narrow(b, depth, self.ctx)
             }
-            if list.groups.len() == 1 {
-                // One group: its box would only repeat the chunks' tests.
-                fan.narrow_to_open(0);
-            } else if !fan.narrow(&list.groups[gi], 0, ctx) {
-                continue;
-            }
-            for (ci, chunk) in group.chunks(CHUNK).enumerate() {
-                if !fan.narrow(&list.chunks[gi * CHUNK + ci], 1, ctx) {
-                    continue;
-                }
-                for &t in chunk {
-                    if t == rays.origin_tri || self.scene.tri_light[t.idx()] == Some(rays.light) {
+            #[inline]
+            fn chunk(&mut self, tris: &[TriId], depth: usize) -> bool {
+                let (vis, rays) = (self.vis, self.rays);
+                for &t in tris {
+                    if t == rays.origin_tri || vis.scene.tri_light[t.idx()] == Some(rays.light) {
                         continue;
                     }
-                    if fan.narrow(&self.tri_boxes[t.idx()], 2, ctx) {
-                        fan.test_level(self.scene, rays, t, 2, out, ctx);
+                    if self.fan.narrow(&vis.tri_boxes[t.idx()], depth + 1, self.ctx) {
+                        self.fan.test_level(vis.scene, rays, t, depth + 1, self.out, self.ctx);
                     }
                 }
+                self.fan.live() == 0
             }
         }
+        fan.narrow_to_open(0);
+        list.walk(&mut Rays { vis: self, rays, fan, out, ctx });
     }
 
     /// Tests the triangles `tris` that the pyramid does not cull against the fan's open active rays,
@@ -744,7 +684,7 @@ impl LieVisibility<'_> {
         }
     }
 
-    /// [`Self::fan_tris`] over a blocker list, skipping the groups and chunks whose boxes the
+    /// [`Self::fan_tris`] over a blocker list, skipping the boxes of its hierarchy that the
     /// pyramid culls.
     fn fan_list(
         &self,
@@ -755,26 +695,29 @@ impl LieVisibility<'_> {
         out: &mut [bool],
         ctx: &mut QueryCtx,
     ) {
-        if list.chunks.is_empty() {
-            return self.fan_tris(rays, list.list, once, fan, out, ctx);
+        /// The pyramid down the hierarchy, then the fan at its chunks.
+        struct Tris<'v, 'a, 'c> {
+            vis: &'v LieVisibility<'a>,
+            rays: &'v LightRays<'v>,
+            once: bool,
+            fan: &'c mut Fan,
+            out: &'c mut [bool],
+            ctx: &'c mut QueryCtx,
         }
-        let per_group = CHUNK * CHUNK;
-        for (gi, group) in list.list.chunks(per_group).enumerate() {
-            if fan.live() == 0 {
-                return;
+        impl ListVisitor for Tris<'_, '_, '_> {
+            #[inline]
+            fn enter(&mut self, b: &Aabb, _: usize) -> bool {
+                self.ctx.stats.box_tests += 1;
+                self.fan.live() > 0 && !self.fan.pyramid.culls_box(b)
             }
-            if list.groups.len() > 1 {
-                ctx.stats.box_tests += 1;
-                if fan.pyramid.culls_box(&list.groups[gi]) {
-                    continue;
-                }
+            #[inline]
+            fn chunk(&mut self, tris: &[TriId], _: usize) -> bool {
+                self.vis.fan_tris(self.rays, tris, self.once, self.fan, self.out, self.ctx);
+                self.fan.live() == 0
             }
-            for (ci, chunk) in group.chunks(CHUNK).enumerate() {
-                ctx.stats.box_tests += 1;
-                if !fan.pyramid.culls_box(&list.chunks[gi * CHUNK + ci]) {
-                    self.fan_tris(rays, chunk, once, fan, out, ctx);
-                }
-            }
+        }
+        if fan.live() > 0 {
+            list.walk(&mut Tris { vis: self, rays, once, fan, out, ctx });
         }
     }
 }
@@ -783,7 +726,7 @@ impl LieVisibility<'_> {
 mod tests {
     use super::*;
     use crate::construct::build;
-    use crate::lie::PlieParams;
+    use crate::lie::{PlieParams, CHUNK, CHUNKED_MIN};
     use crate::render::NoProgress;
 
     /// Every triangle of a long list lies in its chunk's box and that in its group's box; shared
@@ -802,20 +745,32 @@ mod tests {
         for (ri, r) in plie.records.iter().enumerate() {
             let l = vis.record_boxes.of(ri, plie.blockers_of(r));
             if l.list.len() < CHUNKED_MIN {
-                assert!(l.chunks.is_empty() && l.groups.is_empty());
+                assert!(!l.is_long());
                 continue;
             }
             long += 1;
+            let chunks = l.level(0);
+            assert_eq!(chunks.len(), l.list.len().div_ceil(CHUNK));
             for (k, chunk) in l.list.chunks(CHUNK).enumerate() {
-                assert!(chunk.iter().all(|t| inside(&vis.tri_boxes[t.idx()], &l.chunks[k])));
-                assert!(inside(&l.chunks[k], &l.groups[k / CHUNK]));
+                assert!(chunk.iter().all(|t| inside(&vis.tri_boxes[t.idx()], &chunks[k])));
                 let vol = |b: Aabb| b.size().as_dvec3().element_product();
-                volume_sorted += vol(l.chunks[k]);
+                volume_sorted += vol(chunks[k]);
                 let mut ids = l.list.to_vec();
                 ids.sort_unstable();
                 let by_id = ids[k * CHUNK..(k * CHUNK + CHUNK).min(ids.len())].iter().map(|t| vis.tri_boxes[t.idx()]);
                 volume_ids += vol(by_id.reduce(Aabb::union).unwrap());
             }
+            // Each box lies in its parent's, up to a single box.
+            let mut level = 0;
+            while l.level(level).len() > 1 {
+                let (below, above) = (l.level(level), l.level(level + 1));
+                assert_eq!(above.len(), below.len().div_ceil(CHUNK));
+                for (k, b) in below.iter().enumerate() {
+                    assert!(inside(b, &above[k / CHUNK]));
+                }
+                level += 1;
+            }
+            assert_eq!(l.level(level).len(), 1);
         }
         assert!(long > 10, "{long} long lists");
         assert!(volume_sorted < volume_ids, "Morton chunks {volume_sorted} vs id chunks {volume_ids}");

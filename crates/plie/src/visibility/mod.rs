@@ -12,6 +12,7 @@ pub mod fan;
 pub mod footprint;
 pub mod leaf_voxels;
 pub mod lie;
+pub mod list_boxes;
 pub mod mode;
 pub mod octree;
 pub mod query;
