@@ -15,7 +15,7 @@ use crate::geometry::Aabb;
 use crate::octree::Dir;
 
 /// The footprint on one face: the face, and the rectangle `[u0, u1] x [v0, v1]` of the face's own
-/// axes (as [`crate::construct::grid::face_axes`] orders them), in world units, clamped to the face.
+/// axes (as [`crate::lie::frame::face_axes`] orders them), in world units, clamped to the face.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct FaceFootprint {
     /// The face of the leaf.

@@ -25,9 +25,9 @@ use super::leaf_voxels::LeafVoxels;
 use super::list_boxes::{Chunked, ListBoxes, ListVisitor};
 use super::query::SEGMENT_EPS;
 use super::{blocks, Answer, LightRays, Mode, OctreeVisibility, QueryCtx, ShadowRay, Visibility};
-use crate::construct::grid;
-use crate::construct::regions::{in_triangles, FaceFrame};
 use crate::geometry::{Aabb, Segment};
+use crate::lie::frame::{in_triangles, FaceFrame};
+use crate::lie::grid;
 use crate::lie::{Cell, Plie, RecordKind};
 use crate::octree::{Dir, LeafId, Octree};
 use crate::scene::{Scene, TriId};
@@ -102,7 +102,7 @@ impl<'a> LieVisibility<'a> {
     /// built for `scene` and `octree`. Without regions or grids in the P-LIE, the modes that use them
     /// test the blockers instead (still exact).
     pub fn new(scene: &'a Scene, bvh: &'a Bvh, octree: &'a Octree, plie: &'a Plie, mode: Mode) -> LieVisibility<'a> {
-        let pad = scene.scale() * crate::construct::TOLERANCE_REL;
+        let pad = scene.scale() * crate::geometry::TOLERANCE_REL;
         let tri_boxes: Vec<Aabb> = scene.triangles.iter().map(|t| t.aabb().expanded(pad)).collect();
         let voxels = LeafVoxels::new(octree, &tri_boxes, pad);
         let records = plie.records.iter().map(|r| (r.blockers_start, r.blockers_len));
@@ -117,7 +117,7 @@ impl<'a> LieVisibility<'a> {
         for leaf in octree.leaves() {
             let start = own_tris.len();
             own_tris.extend_from_slice(octree.leaf_triangles(leaf));
-            crate::geometry::morton::sort_spatially(scene, &mut own_tris[start..]);
+            crate::lie::order::sort_spatially(scene, &mut own_tris[start..]);
             own.push((start as u32, (own_tris.len() - start) as u32));
         }
         let own_boxes = ListBoxes::new(own.iter().copied(), &own_tris, &tri_boxes);
@@ -166,7 +166,7 @@ impl<'a> LieVisibility<'a> {
                 Some(start) => {
                     let g = self.plie.grids[ri].res as usize;
                     let k = fp.face.axis();
-                    let (u, v) = grid::face_axes(k);
+                    let (u, v) = crate::lie::frame::face_axes(k);
                     let cell = |x: f64, axis: usize| {
                         let (lo, hi) = (bounds.min[axis] as f64, bounds.max[axis] as f64);
                         (((x - lo) / (hi - lo) * g as f64).max(0.0) as usize).min(g - 1)
@@ -726,7 +726,7 @@ impl LieVisibility<'_> {
 mod tests {
     use super::*;
     use crate::construct::build;
-    use crate::lie::{PlieParams, CHUNK, CHUNKED_MIN};
+    use crate::lie::{Grids, PlieParams, CHUNK, CHUNKED_MIN};
     use crate::render::NoProgress;
 
     /// Every triangle of a long list lies in its chunk's box and that in its group's box; shared
@@ -735,8 +735,8 @@ mod tests {
     #[test]
     fn chunk_boxes_cover_their_lists() {
         let scene = crate::scene::builtin::load("huis-a").unwrap();
-        let params = PlieParams { grids: true, ..PlieParams::thesis() };
-        let octree = Octree::build(&scene, params.octree());
+        let params = PlieParams { grids: Grids::Build, ..PlieParams::thesis() };
+        let octree = Octree::build(&scene, params.octree()).expect("valid octree parameters");
         let (plie, _) = build(&scene, &octree, params, &NoProgress);
         let bvh = crate::visibility::bvh::Bvh::build(&scene);
         let vis = LieVisibility::new(&scene, &bvh, &octree, &plie, Mode::Grid);
