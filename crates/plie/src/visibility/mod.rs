@@ -15,6 +15,7 @@ pub mod lie;
 pub mod list_boxes;
 pub mod mode;
 pub mod octree;
+pub mod pyramid;
 pub mod query;
 pub mod shadows;
 
