@@ -323,7 +323,12 @@ impl Loader<'_> {
                         f32::MAX
                     ));
                 }
-                Material { name, albedo: Vec3::new(base[0], base[1], base[2]).clamp(Vec3::ZERO, Vec3::ONE), emission }
+                Material {
+                    name,
+                    albedo: Vec3::new(base[0], base[1], base[2]).clamp(Vec3::ZERO, Vec3::ONE),
+                    emission,
+                    texture: None,
+                }
             }
         };
         let id = self.builder.material(mat.clone());

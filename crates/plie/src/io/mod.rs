@@ -21,6 +21,10 @@ pub mod lights;
 pub mod obj;
 mod obj_lines;
 pub mod plie_file;
+pub mod ply;
+pub mod serialized;
+pub mod texture_file;
+pub mod tri_mesh;
 
 use std::path::Path;
 

@@ -326,6 +326,7 @@ fn material(materials: &[tobj::Material], id: Option<usize>) -> Material {
             name: m.name.clone(),
             albedo: m.diffuse.map_or(Vec3::splat(0.8), Vec3::from).clamp(Vec3::ZERO, Vec3::ONE),
             emission: m.emissive.map_or(Vec3::ZERO, Vec3::from),
+            texture: None,
         },
     }
 }
