@@ -129,8 +129,11 @@ pub fn parse_ply(bytes: &[u8]) -> std::result::Result<TriMesh, PlyError> {
     Ok(mesh)
 }
 
-/// Parses the header: format, elements, the body's bytes and the number of header lines.
-fn header(bytes: &[u8]) -> std::result::Result<(Format, Vec<Element>, &[u8], usize), PlyError> {
+/// A parsed header: format, elements, the body's bytes and the number of header lines.
+type Header<'a> = (Format, Vec<Element>, &'a [u8], usize);
+
+/// Parses the header.
+fn header(bytes: &[u8]) -> std::result::Result<Header<'_>, PlyError> {
     let mut pos = 0;
     let mut line = 0;
     let mut format = None;
