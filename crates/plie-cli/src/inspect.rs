@@ -103,7 +103,7 @@ pub fn run(a: &Args) -> Result<()> {
         crate::checks::output_is_not_input(out, &inputs)?;
     }
     let face: Option<Dir> = a.face.as_deref().map(str::parse).transpose().map_err(anyhow::Error::msg)?;
-    let settings = a.image.settings()?;
+    let mut settings = a.image.settings()?;
     if !(a.line_width.is_finite() && a.line_width > 0.0) {
         bail!("--line-width must be a positive number of pixels");
     }
@@ -113,6 +113,7 @@ pub fn run(a: &Args) -> Result<()> {
         crate::scene_arg::warn_about(&scene);
     }
     let camera = a.camera.camera(&scene)?;
+    a.image.size_for(&mut settings, &scene)?;
     let params = a.params.params(false)?;
     let bar = Bar::new(a.quiet || a.json);
     let Loaded { octree, plie, .. } = load_or_build(&scene, params, a.plie.as_deref(), &bar)?;
@@ -137,11 +138,11 @@ pub fn run(a: &Args) -> Result<()> {
             Output::Png => {
                 let style = OverlayStyle { line_px: a.line_width, exposure_ev: a.image.exposure };
                 let out = render_inspection(&scene, &octree, ins, &camera, &settings, &style, &bar)?;
-                plie::io::save_image(path, a.image.width, a.image.height, &out.pixels)
+                plie::io::save_image(path, settings.width, settings.height, &out.pixels)
                     .with_context(|| format!("cannot write {}", path.display()))?;
             }
             Output::Gltf => {
-                let aspect = a.image.width as f32 / a.image.height as f32;
+                let aspect = settings.width as f32 / settings.height as f32;
                 save_inspection_gltf(path, &scene, &octree, ins, Some((&camera, aspect)))
                     .with_context(|| format!("cannot write {}", path.display()))?;
             }

@@ -87,6 +87,7 @@ pub fn run(a: &Args) -> Result<()> {
         crate::scene_arg::warn_about(&scene);
     }
     let camera = a.camera.camera(&scene)?;
+    a.image.size_for(&mut settings, &scene)?;
 
     let t = Instant::now();
     let bvh = Bvh::build(&scene);
@@ -163,7 +164,7 @@ pub fn run(a: &Args) -> Result<()> {
         }
         _ => out.pixels,
     };
-    plie::io::save_image(&a.output, a.image.width, a.image.height, &pixels)
+    plie::io::save_image(&a.output, settings.width, settings.height, &pixels)
         .with_context(|| format!("cannot write {}", a.output.display()))?;
 
     let s = out.stats;
@@ -175,8 +176,8 @@ pub fn run(a: &Args) -> Result<()> {
             "triangles": scene.triangle_count(),
             "lights": scene.lights.len(),
             "visibility": mode.name(),
-            "width": a.image.width,
-            "height": a.image.height,
+            "width": settings.width,
+            "height": settings.height,
             "integrator": "direct",
             "eye_rays": settings.eye_rays,
             "shadow_rays_per_light": a.image.shadow_rays,
@@ -220,7 +221,7 @@ pub fn run(a: &Args) -> Result<()> {
         eprintln!("visibility       {mode}");
         eprintln!(
             "image            {}x{}, {}x{} eye rays/pixel, {} shadow rays/light",
-            a.image.width, a.image.height, settings.eye_rays, settings.eye_rays, a.image.shadow_rays
+            settings.width, settings.height, settings.eye_rays, settings.eye_rays, a.image.shadow_rays
         );
         eprintln!("threads          {}", rayon::current_num_threads());
         eprintln!("load             {load_seconds:.3} s");

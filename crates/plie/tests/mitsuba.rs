@@ -110,9 +110,14 @@ fn cornell_box_in_0_6_syntax_is_the_same_box() {
     assert_eq!(old.camera.map(|c| c.fov_deg), new.camera.map(|c| c.fov_deg), "fovAxis read");
     assert!(close(old.camera.unwrap().eye, new.camera.unwrap().eye), "toWorld read");
     assert_eq!(old.lights.len(), 1);
-    assert!(close(old.lights[0].normal, new.lights[0].normal) && (old.lights[0].area - new.lights[0].area).abs() < 1e-6);
+    assert!(
+        close(old.lights[0].normal, new.lights[0].normal) && (old.lights[0].area - new.lights[0].area).abs() < 1e-6
+    );
     let area = |s: &Scene, m: &str| -> f32 {
-        (0..s.triangle_count()).filter(|&t| s.material_of(TriId(t as u32)).name == m).map(|t| s.triangles[t].area()).sum()
+        (0..s.triangle_count())
+            .filter(|&t| s.material_of(TriId(t as u32)).name == m)
+            .map(|t| s.triangles[t].area())
+            .sum()
     };
     assert!((area(&old, "red") - 4.0).abs() < 1e-4 && (area(&old, "green") - 4.0).abs() < 1e-4);
 }
@@ -166,7 +171,10 @@ fn warnings_for_what_plie_changes_or_ignores() {
     assert!(w.contains("ignored 1 emitter") && w.contains("point (") && w.contains("meshes.xml:16"), "{w}");
     let changed: Vec<&String> = s.warnings.iter().filter(|w| w.contains("diffuse part")).collect();
     assert_eq!(changed.len(), 1, "one warning lists every changed material: {w}");
-    assert!(changed[0].contains("'blue-plastic' (plastic: its diffuse reflectance") && changed[0].contains("'metal' (conductor: black"));
+    assert!(
+        changed[0].contains("'blue-plastic' (plastic: its diffuse reflectance")
+            && changed[0].contains("'metal' (conductor: black")
+    );
     assert!(w.contains("dropped 1 shape") && w.contains("glass (dielectric)"), "{w}");
     let plastic = s.materials.iter().find(|m| m.name == "blue-plastic").unwrap();
     assert_eq!(plastic.albedo, Vec3::new(0.1, 0.2, 0.7), "a plastic renders its diffuse reflectance");
@@ -194,8 +202,11 @@ fn point_light_alone_is_an_error_naming_it() {
 #[test]
 fn every_transform_step() {
     let t = |steps: &str| -> Vec<[Vec3; 3]> {
-        let s = try_xml(&scene3(&format!(r#"<shape type="rectangle"><transform name="to_world">{steps}</transform></shape>"#)), &[])
-            .unwrap();
+        let s = try_xml(
+            &scene3(&format!(r#"<shape type="rectangle"><transform name="to_world">{steps}</transform></shape>"#)),
+            &[],
+        )
+        .unwrap();
         body_triangles(&s)
     };
     let v = Vec3::new;
@@ -214,18 +225,23 @@ fn every_transform_step() {
     // A mirroring transform keeps a rectangle facing where Mitsuba's normal points (+z here).
     let m = t(r#"<scale x="-1"/>"#);
     assert!(m.iter().all(|tri| (tri[1] - tri[0]).cross(tri[2] - tri[0]).z > 0.0));
-    let f = try_xml(&scene3(r#"<shape type="rectangle"><boolean name="flip_normals" value="true"/></shape>"#), &[]).unwrap();
+    let f = try_xml(&scene3(r#"<shape type="rectangle"><boolean name="flip_normals" value="true"/></shape>"#), &[])
+        .unwrap();
     assert!(body_triangles(&f).iter().all(|tri| (tri[1] - tri[0]).cross(tri[2] - tri[0]).z < 0.0), "flip_normals");
 }
 
 #[test]
 fn defaults_substitution_include_and_ref() {
     let inc = r#"<scene version="3.0.0"><bsdf type="diffuse" id="m"><rgb name="reflectance" value="$r, 0.25, 0.5"/></bsdf></scene>"#;
-    let xml = scene3(r#"<default name="r" value="0.75"/><include filename="inc.xml"/>
-        <shape type="cube"><ref id="m"/></shape>"#);
+    let xml = scene3(
+        r#"<default name="r" value="0.75"/><include filename="inc.xml"/>
+        <shape type="cube"><ref id="m"/></shape>"#,
+    );
     let s = try_xml(&xml, &[("inc.xml", inc)]).unwrap();
     assert_eq!(s.materials.iter().find(|m| m.name == "m").unwrap().albedo, Vec3::new(0.75, 0.25, 0.5));
-    let e = error(&scene3(r#"<shape type="cube"><bsdf type="diffuse"><float name="reflectance" value="$nope"/></bsdf></shape>"#));
+    let e = error(&scene3(
+        r#"<shape type="cube"><bsdf type="diffuse"><float name="reflectance" value="$nope"/></bsdf></shape>"#,
+    ));
     assert!(e.contains("$nope") && e.contains("not defined"), "{e}");
     let e = error(&scene3(r#"<shape type="cube"><ref id="missing"/></shape>"#));
     assert!(e.contains("no element has the id 'missing'"), "{e}");
@@ -265,7 +281,8 @@ fn errors_name_the_element_and_line() {
 #[test]
 fn mesh_files_with_errors_name_their_file() {
     let xml = scene3(r#"<shape type="ply"><string name="filename" value="bad.ply"/></shape>"#);
-    let e = try_xml(&xml, &[("bad.ply", "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nend_header\n1\n")]).unwrap_err();
+    let e = try_xml(&xml, &[("bad.ply", "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nend_header\n1\n")])
+        .unwrap_err();
     assert!(e.contains("bad.ply") && e.contains("no x, y, z"), "{e}");
     let xml = scene3(r#"<shape type="serialized"><string name="filename" value="bad.serialized"/></shape>"#);
     let e = try_xml(&xml, &[("bad.serialized", "not zlib at all")]).unwrap_err();
@@ -352,7 +369,10 @@ fn obj_map_kd_textures() {
     assert!((low - red).abs().max_element() < 1e-5, "{low} vs {red}");
     let dark = Vec3::new(100.0, 20.0, 15.0).map(|c| srgb_to_linear(c / 255.0));
     assert!((high - dark).abs().max_element() < 1e-5, "the top texel row is darker: {high} vs {dark}");
-    let outside = folder(&[("q.obj", "mtllib q.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nusemtl l\nf 1 2 3\n"), ("q.mtl", "newmtl l\nKe 1 1 1\nmap_Kd ../../x.png\n")]);
+    let outside = folder(&[
+        ("q.obj", "mtllib q.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nusemtl l\nf 1 2 3\n"),
+        ("q.mtl", "newmtl l\nKe 1 1 1\nmap_Kd ../../x.png\n"),
+    ]);
     let e = load_scene(&outside.path().join("q.obj")).unwrap_err().to_string();
     assert!(e.contains("map_Kd") && e.contains("outside the scene's folder"), "{e}");
 }
@@ -363,7 +383,11 @@ fn outside_paths_only_when_allowed() {
     let inner = parent.path().join("scene");
     std::fs::create_dir(&inner).unwrap();
     std::fs::write(parent.path().join("o.obj"), "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n").unwrap();
-    std::fs::write(inner.join("scene.xml"), scene3(r#"<shape type="obj"><string name="filename" value="../o.obj"/></shape>"#)).unwrap();
+    std::fs::write(
+        inner.join("scene.xml"),
+        scene3(r#"<shape type="obj"><string name="filename" value="../o.obj"/></shape>"#),
+    )
+    .unwrap();
     let e = load_scene(&inner.join("scene.xml")).unwrap_err().to_string();
     assert!(e.contains("outside the scene's folder"), "{e}");
     let s = load_scene_with(&inner.join("scene.xml"), LoadOptions { allow_outside_paths: true }).unwrap();

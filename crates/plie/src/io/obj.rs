@@ -89,7 +89,8 @@ pub fn load_obj_mesh(path: &Path, flip_v: bool) -> Result<TriMesh> {
         let base = mesh.positions.len() as u32;
         mesh.positions.extend(m.positions.chunks_exact(3).map(|p| Vec3::new(p[0], p[1], p[2])));
         if all_uv {
-            mesh.uvs.extend(m.texcoords.chunks_exact(2).map(|t| Vec2::new(t[0], if flip_v { 1.0 - t[1] } else { t[1] })));
+            mesh.uvs
+                .extend(m.texcoords.chunks_exact(2).map(|t| Vec2::new(t[0], if flip_v { 1.0 - t[1] } else { t[1] })));
         }
         let n = mesh.positions.len() as u32;
         for t in m.indices.chunks_exact(3) {
@@ -464,7 +465,10 @@ fn build(
         let uvs = (mat.texture.is_some() && has_uvs(mesh)).then_some(&mesh.texcoords);
         if mat.texture.is_some() && uvs.is_none() {
             m = b.material(Material { texture: None, ..mat.clone() });
-            ignored.push(("map_Kd on faces without texture coordinates (vt): the flat Kd colour is used there".into(), mat.name.clone()));
+            ignored.push((
+                "map_Kd on faces without texture coordinates (vt): the flat Kd colour is used there".into(),
+                mat.name.clone(),
+            ));
         }
         let uv = |i: u32| {
             let t = uvs.and_then(|t| t.get(i as usize * 2..i as usize * 2 + 2)).unwrap_or(&[0.0, 1.0]);

@@ -54,7 +54,9 @@ pub fn load_mitsuba_with(path: &Path, opts: LoadOptions) -> Result<Scene> {
     let doc = parse_scene(path, opts)?;
     let major = doc.version.split('.').next().and_then(|v| v.parse::<u32>().ok());
     if !matches!(major, Some(0) | Some(2) | Some(3)) {
-        return Err(doc.root.error(format!("version '{}' is not supported (0.x, 2.x and 3.x are)", short(&doc.version))));
+        return Err(doc
+            .root
+            .error(format!("version '{}' is not supported (0.x, 2.x and 3.x are)", short(&doc.version))));
     }
     let mut ids = HashMap::new();
     register_ids(&doc.root, &mut ids)?;
@@ -86,7 +88,9 @@ pub fn load_mitsuba_with(path: &Path, opts: LoadOptions) -> Result<Scene> {
                 t => l.other_emitters.push(format!("{t} ({}:{})", e.file.display(), e.line)),
             },
             "bsdf" | "texture" | "default" | "integrator" | "sampler" | "film" | "rfilter" => {}
-            "medium" | "phase" => l.notes.push(format!("{} at line {} is ignored: plie renders no media", e.describe(), e.line)),
+            "medium" | "phase" => {
+                l.notes.push(format!("{} at line {} is ignored: plie renders no media", e.describe(), e.line))
+            }
             t => return Err(e.error(format!("<{t}> is not a scene element plie reads"))),
         }
     }
@@ -192,7 +196,11 @@ impl<'a> Loader<'a> {
         match ty {
             "shapegroup" => return Ok(()),
             "instance" => {
-                let r = e.children.iter().find(|c| c.tag == "ref").ok_or_else(|| e.error("names no shapegroup (<ref id>)".into()))?;
+                let r = e
+                    .children
+                    .iter()
+                    .find(|c| c.tag == "ref")
+                    .ok_or_else(|| e.error("names no shapegroup (<ref id>)".into()))?;
                 let g = self.deref(r)?;
                 if g.tag != "shape" || g.attr("type") != Some("shapegroup") {
                     return Err(r.error(format!("names {}, not a shapegroup", g.describe())));
@@ -254,7 +262,9 @@ impl<'a> Loader<'a> {
                         }
                         radiance = Some(v);
                     }
-                    t => return Err(c.error(format!("emitter type '{}' on a shape: only 'area' is supported", short(t)))),
+                    t => {
+                        return Err(c.error(format!("emitter type '{}' on a shape: only 'area' is supported", short(t))))
+                    }
                 },
                 _ => {}
             }
@@ -269,7 +279,8 @@ impl<'a> Loader<'a> {
             return Ok(());
         }
         let textured = bsdf.texture.is_some() && !mesh.uvs.is_empty() && !bsdf.dropped;
-        let key = (bsdf_elem.map_or(std::ptr::null(), |x| x as *const Elem), emission.to_array().map(f32::to_bits), textured);
+        let key =
+            (bsdf_elem.map_or(std::ptr::null(), |x| x as *const Elem), emission.to_array().map(f32::to_bits), textured);
         let m = match self.materials.get(&key) {
             Some(&m) => m,
             None => {
@@ -340,7 +351,11 @@ impl<'a> Loader<'a> {
         let name = e.attr("id").map(str::to_string).unwrap_or_else(|| format!("{} line {}", e.file.display(), e.line));
         let ty = e.need("type")?;
         let nested = |l: &Self| -> Result<&'a Elem> {
-            let c = e.children.iter().find(|c| c.tag == "bsdf" || c.tag == "ref").ok_or_else(|| e.error("has no nested BSDF".into()))?;
+            let c = e
+                .children
+                .iter()
+                .find(|c| c.tag == "bsdf" || c.tag == "ref")
+                .ok_or_else(|| e.error("has no nested BSDF".into()))?;
             l.deref(c)
         };
         let change = |l: &mut Self, how: &str| l.changed.push((name.clone(), format!("{ty}: {how}")));
@@ -439,7 +454,9 @@ impl<'a> Loader<'a> {
     fn sensor(&mut self, e: &Elem) -> Result<()> {
         match e.need("type")? {
             "perspective" => {}
-            "thinlens" => self.notes.push(format!("sensor at line {}: thinlens is rendered as a pinhole (no depth of field)", e.line)),
+            "thinlens" => self
+                .notes
+                .push(format!("sensor at line {}: thinlens is rendered as a pinhole (no depth of field)", e.line)),
             t => return Err(e.error(format!("sensor type '{}' is not supported (perspective is)", short(t)))),
         }
         if self.camera {
@@ -458,7 +475,11 @@ impl<'a> Loader<'a> {
         let fov = match (find(e, "fov"), string(e, "focal_length")?) {
             (Some(_), _) => float(e, "fov", 0.0)?,
             (None, Some(f)) => {
-                let mm: f32 = f.trim().trim_end_matches("mm").parse().map_err(|_| e.error(format!("focal_length '{}' is not a length in mm", short(f))))?;
+                let mm: f32 = f
+                    .trim()
+                    .trim_end_matches("mm")
+                    .parse()
+                    .map_err(|_| e.error(format!("focal_length '{}' is not a length in mm", short(f))))?;
                 2.0 * (18.0 / mm).atan().to_degrees()
             }
             (None, None) => 2.0 * (18.0f32 / 50.0).atan().to_degrees(),
@@ -485,9 +506,13 @@ impl<'a> Loader<'a> {
         let up = m.transform_vector3(Vec3::Y);
         let left = m.transform_vector3(Vec3::X);
         if forward.cross(up).dot(left) > 0.0 {
-            self.notes.push(format!("sensor at line {}: its transform mirrors the image; plie renders it unmirrored", e.line));
+            self.notes.push(format!(
+                "sensor at line {}: its transform mirrors the image; plie renders it unmirrored",
+                e.line
+            ));
         }
-        let camera = Camera { eye, target: eye + forward.normalize_or_zero(), up, fov_deg: 2.0 * tan_v.atan().to_degrees() };
+        let camera =
+            Camera { eye, target: eye + forward.normalize_or_zero(), up, fov_deg: 2.0 * tan_v.atan().to_degrees() };
         camera.validate().map_err(|err| e.error(err.to_string()))?;
         self.b.camera(camera);
         self.b.image_size(w as u32, h as u32);
@@ -514,7 +539,10 @@ impl<'a> Loader<'a> {
         if !self.changed.is_empty() {
             self.changed.dedup();
             let list: Vec<String> = self.changed.iter().map(|(n, how)| format!("'{n}' ({how})")).collect();
-            warnings.push(format!("materials plie cannot render yet were rendered by their diffuse part: {}", list.join(", ")));
+            warnings.push(format!(
+                "materials plie cannot render yet were rendered by their diffuse part: {}",
+                list.join(", ")
+            ));
         }
         if !self.dropped.is_empty() {
             let mut names = self.dropped.clone();

@@ -41,7 +41,9 @@ pub fn number_attr(e: &Elem, attr: &str) -> Result<Option<f32>> {
 pub fn float(e: &Elem, name: &str, default: f32) -> Result<f32> {
     match find(e, name) {
         None => Ok(default),
-        Some(p) if p.tag == "float" || p.tag == "integer" => number_attr(p, "value")?.ok_or_else(|| p.error("has no value".into())),
+        Some(p) if p.tag == "float" || p.tag == "integer" => {
+            number_attr(p, "value")?.ok_or_else(|| p.error("has no value".into()))
+        }
         Some(p) => Err(p.error(format!("'{name}' must be a <float>"))),
     }
 }
@@ -197,7 +199,9 @@ pub fn transform_of(t: &Elem) -> Result<Mat4> {
                 let new_up = dir.cross(left);
                 Mat4::from_cols(left.extend(0.0), new_up.extend(0.0), dir.extend(0.0), origin.extend(1.0))
             }
-            t => return Err(s.error(format!("<{t}> is not a transform step (matrix, translate, rotate, scale, lookat)"))),
+            t => {
+                return Err(s.error(format!("<{t}> is not a transform step (matrix, translate, rotate, scale, lookat)")))
+            }
         };
         m = step * m;
     }

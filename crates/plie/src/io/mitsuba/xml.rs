@@ -64,7 +64,11 @@ impl Elem {
 
     /// An error at this element: file, line, the element and `message`.
     pub fn error(&self, message: String) -> Error {
-        Error::Parse { path: (*self.file).clone(), line: Some(self.line), message: format!("{}: {message}", self.describe()) }
+        Error::Parse {
+            path: (*self.file).clone(),
+            line: Some(self.line),
+            message: format!("{}: {message}", self.describe()),
+        }
     }
 }
 
@@ -101,12 +105,16 @@ impl Ctx {
         let bytes = read_bounded(path, MAX_XML_BYTES)?;
         let fail = |line: Option<usize>, m: String| Error::Parse { path: path.to_path_buf(), line, message: m };
         let text = std::str::from_utf8(&bytes).map_err(|e| fail(None, format!("not UTF-8 text: {e}")))?;
-        let doc = roxmltree::Document::parse(text).map_err(|e| fail(Some(e.pos().row as usize), format!("malformed XML: {e}")))?;
+        let doc = roxmltree::Document::parse(text)
+            .map_err(|e| fail(Some(e.pos().row as usize), format!("malformed XML: {e}")))?;
         let file = Rc::new(path.to_path_buf());
         let root = doc.root_element();
         let line = |n: roxmltree::Node| doc.text_pos_at(n.range().start).row as usize;
         if root.tag_name().name() != "scene" {
-            return Err(fail(Some(line(root)), format!("the root element is <{}>, not <scene>", short(root.tag_name().name()))));
+            return Err(fail(
+                Some(line(root)),
+                format!("the root element is <{}>, not <scene>", short(root.tag_name().name())),
+            ));
         }
         // Defaults first: they apply to the whole file (a parameter already set is kept).
         for d in root.children().filter(|n| n.is_element() && n.tag_name().name() == "default") {
@@ -137,7 +145,12 @@ impl Ctx {
         Ok(out)
     }
 
-    fn convert(&mut self, n: roxmltree::Node, file: &Rc<PathBuf>, line: &dyn Fn(roxmltree::Node) -> usize) -> Result<Elem> {
+    fn convert(
+        &mut self,
+        n: roxmltree::Node,
+        file: &Rc<PathBuf>,
+        line: &dyn Fn(roxmltree::Node) -> usize,
+    ) -> Result<Elem> {
         self.elements += 1;
         let at = line(n);
         if self.elements > MAX_ELEMENTS {
@@ -181,7 +194,10 @@ impl Ctx {
             if name.is_empty() {
                 out.push('$');
             } else {
-                let v = self.params.get(name).ok_or_else(|| format!("'${}' is not defined by any <default>", short(name)))?;
+                let v = self
+                    .params
+                    .get(name)
+                    .ok_or_else(|| format!("'${}' is not defined by any <default>", short(name)))?;
                 out.push_str(v);
             }
             rest = &after[len..];
