@@ -1,15 +1,20 @@
 //! Wavefront OBJ + MTL scenes (SPEC §1 scene model), read with `tobj` through a checking line filter
 //! (`obj_lines.rs`).
 //!
-//! What is read: `v` (with an optional `w`, which divides; vertex colours are ignored), `f` (polygons
-//! are fan-triangulated; positive and negative indices; texture and normal indices are ignored), `o`/`g`,
-//! `mtllib` (paths relative to the OBJ; several names on one line are allowed), `usemtl`, and in the MTL
-//! files `newmtl`, `Kd` (diffuse albedo, clamped to [0, 1]) and `Ke` (emitted radiance). A repeated
-//! `Kd` in one material: the last one counts, as in other OBJ readers. Everything else (normals, texture
-//! coordinates, `Ka`, `Ks`, `d`, `Tr`, maps, lines, points) is ignored: surfaces are opaque and
-//! Lambertian; a non-zero `Ks` and a `map_Kd` (which would change how the scene looks) are reported
-//! in [`Scene::warnings`]. An emissive triangle emits on the side its counter-clockwise winding faces;
-//! vertex normals are not used. Emissive triangles are grouped into lights by [`super::lights`].
+//! What is read: `v` (with an optional `w`, which divides; vertex colours are ignored), `vt` (texture
+//! coordinates; a malformed one reads as (0, 0), as they were once ignored), `f` (polygons are
+//! fan-triangulated; positive and negative indices; texture indices are kept where every corner of the
+//! face has a valid one; normal indices are ignored), `o`/`g`, `mtllib` (paths relative to the OBJ;
+//! several names on one line are allowed), `usemtl`, and in the MTL files `newmtl`, `Kd` (diffuse
+//! albedo, clamped to [0, 1]), `Ke` (emitted radiance) and `map_Kd` (a texture the albedo is multiplied
+//! by, issue 18: sRGB, bilinear, repeating; `v` flipped, since OBJ puts `v = 0` at the image's bottom;
+//! its file confined to the scene's folder like `mtllib`). A repeated `Kd` in one material: the last
+//! one counts, as in other OBJ readers. Everything else (normals, `Ka`, `Ks`, `d`, `Tr`, other maps,
+//! lines, points) is ignored: surfaces are opaque and Lambertian; a non-zero `Ks`, a missing `map_Kd`
+//! file and a `map_Kd` on faces without texture coordinates (which would change how the scene looks)
+//! are reported in [`Scene::warnings`]. An emissive triangle emits on the side its counter-clockwise
+//! winding faces; vertex normals are not used. Emissive triangles are grouped into lights by
+//! [`super::lights`]. [`load_obj_mesh`] reads an OBJ's geometry alone (for Mitsuba scenes).
 //!
 //! Faces before any `usemtl` get a grey default material (albedo 0.8). Everything that would make a
 //! scene silently differ from its file is an error naming the file and line: a `mtllib` that cannot be

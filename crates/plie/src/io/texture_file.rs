@@ -19,7 +19,13 @@ pub const MAX_TEXTURE_SIDE: u32 = 16384;
 /// Loads the image at `path` as a texture; `srgb`: decode 8/16-bit values with the sRGB curve.
 pub fn load_texture(path: &Path, srgb: bool) -> Result<Texture> {
     let bytes = read_bounded(path, MAX_INPUT_BYTES)?;
-    let fail = |m: String| parse_error(path, None, m);
+    let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+    decode_texture(&name, bytes, srgb).map_err(|m| parse_error(path, None, m))
+}
+
+/// Decodes an image file's bytes as a texture named `name`; `srgb` as in [`load_texture`].
+pub fn decode_texture(name: &str, bytes: Vec<u8>, srgb: bool) -> std::result::Result<Texture, String> {
+    let fail = |m: String| m;
     let mut reader = ImageReader::new(Cursor::new(bytes))
         .with_guessed_format()
         .map_err(|e| fail(format!("cannot read texture: {e}")))?;
@@ -44,6 +50,5 @@ pub fn load_texture(path: &Path, srgb: bool) -> Result<Texture> {
             }
         })
         .collect();
-    let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
-    Texture::new(&name, w, h, texels).ok_or_else(|| fail(format!("texture has an empty size {w}x{h}")))
+    Texture::new(name, w, h, texels).ok_or_else(|| fail(format!("texture has an empty size {w}x{h}")))
 }
