@@ -15,7 +15,7 @@ use plie::octree::{Dir, Octree};
 use serde_json::{json, Value};
 
 use crate::image_args::ImageArgs;
-use crate::plie_args::{load_or_build, Loaded, PlieArgs};
+use crate::plie_args::{load_file, load_or_build, Loaded, PlieArgs};
 use crate::progress::Bar;
 use crate::scene_arg::{parse_vec3, CameraArgs, SceneArgs};
 
@@ -63,7 +63,8 @@ pub struct Args {
     threads: Option<usize>,
     #[command(flatten)]
     params: PlieArgs,
-    /// Inspect this P-LIE file (from `plie build`) instead of building one.
+    /// Inspect this P-LIE file (from `plie build`) instead of building one; its build parameters come
+    /// from the file (an option given that contradicts it is an error).
     #[arg(long, value_name = "FILE.plie")]
     plie: Option<PathBuf>,
     /// No progress bar, no description of the inspected cell on stderr.
@@ -89,7 +90,7 @@ fn output_kind(path: &Path) -> Result<Output> {
     Ok(kind)
 }
 
-pub fn run(a: &Args) -> Result<()> {
+pub fn run(a: &Args, matches: &clap::ArgMatches) -> Result<()> {
     crate::scenes::set_threads(a.threads)?;
     if a.output.is_none() && !a.summary {
         bail!("nothing to do: give -o OUT (.png, .gltf, .glb) with --cell X,Y,Z, or --summary");
@@ -116,7 +117,10 @@ pub fn run(a: &Args) -> Result<()> {
     a.image.size_for(&mut settings, &scene)?;
     let params = a.params.params(false)?;
     let bar = Bar::new(a.quiet || a.json);
-    let Loaded { octree, plie, .. } = load_or_build(&scene, params, a.plie.as_deref(), &bar)?;
+    let Loaded { octree, plie, .. } = match a.plie.as_deref() {
+        Some(file) => load_file(&scene, file, &a.params, matches)?,
+        None => load_or_build(&scene, params, None, &bar)?,
+    };
     let inspector = Inspector::new(&scene, &octree, &plie)?;
     let light = a.light.map(|i| inspector.light(i)).transpose()?;
     let leaf = a.cell.map(|p| inspector.leaf_at(p)).transpose()?;

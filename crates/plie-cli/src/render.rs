@@ -14,7 +14,7 @@ use serde_json::json;
 
 use crate::image_args::ImageArgs;
 use crate::path_args::{Integrator, PathArgs};
-use crate::plie_args::{load_or_build, PlieArgs};
+use crate::plie_args::{load_file, load_or_build, PlieArgs};
 use crate::progress::Bar;
 use crate::render_path;
 use crate::scene_arg::{CameraArgs, SceneArgs};
@@ -54,7 +54,8 @@ pub struct Args {
     #[command(flatten)]
     params: PlieArgs,
     /// Use this P-LIE file (from `plie build`) instead of building one; only the P-LIE modes (`lie`,
-    /// `umbra`, `penumbra`, `grid`) use it. The octree options must be those it was built with.
+    /// `umbra`, `penumbra`, `grid`) use it. Its build parameters come from the file: build options
+    /// can be left out, and one given that contradicts the file is an error.
     #[arg(long, value_name = "FILE.plie")]
     plie: Option<PathBuf>,
     /// Print human-readable figures on stderr (times, shadow rays, and how a P-LIE answered them).
@@ -68,7 +69,7 @@ pub struct Args {
     quiet: bool,
 }
 
-pub fn run(a: &Args) -> Result<()> {
+pub fn run(a: &Args, matches: &clap::ArgMatches) -> Result<()> {
     crate::scenes::set_threads(a.threads)?;
     plie::io::ImageFormat::from_path(&a.output)?;
     let inputs: Vec<&std::path::Path> = a.scene.file().into_iter().chain(a.plie.as_deref()).collect();
@@ -104,7 +105,10 @@ pub fn run(a: &Args) -> Result<()> {
     let params = a.params.params(asked == Mode::Grid)?;
     let t = Instant::now();
     let (mode, octree, plie, plie_seconds, load_plie_seconds) = if asked.needs_plie() || plie_file.is_some() {
-        let got = load_or_build(&scene, params, plie_file, &bar)?;
+        let got = match plie_file {
+            Some(file) => load_file(&scene, file, &a.params, matches)?,
+            None => load_or_build(&scene, params, None, &bar)?,
+        };
         let mode = a.visibility.unwrap_or_else(|| best_mode(&got.plie.params));
         (mode, got.octree, Some(got.plie), got.build_seconds, got.load_seconds)
     } else {
