@@ -210,9 +210,9 @@ impl PlieArgs {
             checks.push(("refine", "--refine", refine_words(&asked), refine_words(&file.refine)));
         }
         for (id, option, given_flag, file_has) in [
-            ("no_grids", "--no-grids", self.no_grids, file.grids),
-            ("no_regions", "--no-regions", self.no_regions, file.regions),
-            ("no_propagation", "--no-propagation", self.no_propagation, file.propagation),
+            ("no_grids", "--no-grids", self.no_grids, file.has_grids()),
+            ("no_regions", "--no-regions", self.no_regions, file.has_regions()),
+            ("no_propagation", "--no-propagation", self.no_propagation, file.propagates()),
         ] {
             if given(id) && given_flag && file_has {
                 bail!(
