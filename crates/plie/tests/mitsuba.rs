@@ -394,11 +394,11 @@ fn outside_paths_only_when_allowed() {
     assert_eq!(s.triangle_count(), 3);
 }
 
-/// Mitsuba 3 (`pip install mitsuba`), where importable, renders cornell-3.xml; plie's lit pixels'
-/// mean radiance must agree within 1.5%. The Python is `$PLIE_MITSUBA_PYTHON`, else
+/// Mitsuba 3 (`pip install mitsuba`), where importable, renders cornell-3.xml and textured.xml; plie's
+/// lit pixels' mean radiance must agree within 1.5%. The Python is `$PLIE_MITSUBA_PYTHON`, else
 /// `/tmp/mitsuba-venv/bin/python`, else `python3`.
 #[test]
-fn mitsuba_3_agrees_on_the_cornell_box() {
+fn mitsuba_3_agrees_on_the_cornell_boxes() {
     let python = std::env::var("PLIE_MITSUBA_PYTHON").ok().or_else(|| {
         let venv = "/tmp/mitsuba-venv/bin/python";
         Path::new(venv).exists().then(|| venv.to_string())
@@ -412,17 +412,26 @@ fn mitsuba_3_agrees_on_the_cornell_box() {
         eprintln!("notice: Mitsuba 3 is not importable by {python}: skipping the reference comparison");
         return;
     }
-    let size = 32u32;
+    for scene in ["cornell-3.xml", "textured.xml"] {
+        let diff = against_mitsuba(&python, scene, 32);
+        assert!(diff.abs() < 0.015, "{scene}: plie differs from Mitsuba 3 by {:+.2}%", diff * 100.0);
+    }
+}
+
+/// Renders `scene` with Mitsuba 3 (scalar_rgb, its `direct` integrator, 1024 samples per pixel, box
+/// filter) and with plie (16 x 16 regular eye rays per pixel, 16 shadow rays per light) at `size` x
+/// `size`; the relative difference of plie's summed radiance over the pixels Mitsuba finds lit.
+fn against_mitsuba(python: &str, scene: &str, size: u32) -> f64 {
     let out = tempfile::tempdir().unwrap();
     let reference = out.path().join("mitsuba.txt");
     let script = format!(
         "import mitsuba as mi, numpy as np\nmi.set_variant('scalar_rgb')\n\
          s = mi.load_file(r'{}', res={size}, spp=1024)\nimg = np.array(mi.render(s))\n\
          np.savetxt(r'{}', img.reshape(-1, 3))\n",
-        data("cornell-3.xml").display(),
+        data(scene).display(),
         reference.display()
     );
-    let run = std::process::Command::new(&python).args(["-c", &script]).output().unwrap();
+    let run = std::process::Command::new(python).args(["-c", &script]).output().unwrap();
     assert!(run.status.success(), "mitsuba failed: {}", String::from_utf8_lossy(&run.stderr));
     let text = std::fs::read_to_string(&reference).unwrap();
     let mitsuba: Vec<Vec3> = text
@@ -433,9 +442,9 @@ fn mitsuba_3_agrees_on_the_cornell_box() {
         })
         .collect();
     assert_eq!(mitsuba.len(), (size * size) as usize);
-    let s = load("cornell-3.xml");
+    let s = load(scene);
     // Many regular eye rays per pixel: the light's edges are then covered as Mitsuba's random
-    // samples cover them (at 2x2 the aliasing of those bright edges alone is about 2%).
+    // samples cover them (at 4 x 4 the aliasing of those bright edges alone was about -1.7%).
     let settings = RenderSettings { width: size, height: size, eye_rays: 16, shadow_rays: 16, seed: 1 };
     let plie = image(&s, Mode::Bvh, &settings);
     let (mut a, mut b) = (0.0f64, 0.0f64);
@@ -446,6 +455,41 @@ fn mitsuba_3_agrees_on_the_cornell_box() {
         }
     }
     let diff = b / a - 1.0;
-    eprintln!("mean radiance of the lit pixels: Mitsuba {a:.3}, plie {b:.3} (sums), difference {:+.3}%", diff * 100.0);
-    assert!(diff.abs() < 0.015, "plie differs from Mitsuba 3 by {:+.2}%", diff * 100.0);
+    eprintln!(
+        "{scene}: summed radiance of the lit pixels: Mitsuba {a:.3}, plie {b:.3}, difference {:+.3}%",
+        diff * 100.0
+    );
+    diff
+}
+
+#[test]
+fn fov_axes_and_focal_length() {
+    let fov = |sensor: &str| -> f32 {
+        let xml = scene3(&format!(
+            r#"<shape type="cube"/><sensor type="perspective">{sensor}
+               <film type="hdrfilm"><integer name="width" value="200"/><integer name="height" value="100"/></film></sensor>"#
+        ));
+        try_xml(&xml, &[]).unwrap().camera.unwrap().fov_deg
+    };
+    let vertical = |h_deg: f32, ratio: f32| 2.0 * ((h_deg.to_radians() / 2.0).tan() * ratio).atan().to_degrees();
+    let near = |a: f32, b: f32| (a - b).abs() < 1e-3;
+    assert!(near(fov(r#"<float name="fov" value="60"/>"#), vertical(60.0, 0.5)), "fov_axis x is the default");
+    assert!(near(fov(r#"<float name="fov" value="60"/><string name="fov_axis" value="y"/>"#), 60.0));
+    assert!(near(fov(r#"<float name="fov" value="60"/><string name="fov_axis" value="smaller"/>"#), 60.0));
+    assert!(near(
+        fov(r#"<float name="fov" value="60"/><string name="fov_axis" value="larger"/>"#),
+        vertical(60.0, 0.5)
+    ));
+    let diag = 100.0 / (200.0f32 * 200.0 + 100.0 * 100.0).sqrt();
+    assert!(near(
+        fov(r#"<float name="fov" value="60"/><string name="fov_axis" value="diagonal"/>"#),
+        vertical(60.0, diag)
+    ));
+    assert!(near(
+        fov(r#"<string name="focal_length" value="50mm"/>"#),
+        vertical(2.0 * (18.0f32 / 50.0).atan().to_degrees(), 0.5)
+    ));
+    let e =
+        error(&scene3(r#"<shape type="cube"/><sensor type="perspective"><float name="fov" value="180"/></sensor>"#));
+    assert!(e.contains("fov 180 must be between 0 and 180"), "{e}");
 }
