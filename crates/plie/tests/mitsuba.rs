@@ -272,7 +272,11 @@ fn errors_name_the_element_and_line() {
         ("<scene version=\"3.0.0\">\n<shape type=\"cube\"><bsdf type=\"diffuse\"><texture type=\"checkerboard\" name=\"reflectance\"/></bsdf></shape></scene>", "texture type 'checkerboard' is not supported"),
         ("<scene version=\"3.0.0\"><shape type=\"cube\" id=\"a\"/>\n<shape type=\"cube\" id=\"a\"/></scene>", ":2: <shape type=\"cube\" id=\"a\">: the id 'a' is used twice"),
     ];
-    for (xml, want) in cases {
+    let deep = format!("<scene version=\"3.0.0\">{}{}</scene>", "<a>".repeat(100_000), "</a>".repeat(100_000));
+    let selfref = "<scene version=\"3.0.0\"><bsdf type=\"twosided\" id=\"a\"><ref id=\"a\"/></bsdf>\n\
+                   <shape type=\"cube\"><ref id=\"a\"/></shape></scene>";
+    let more = [(deep.as_str(), "nest more than 64 levels"), (selfref, "BSDFs nest more than 16 levels deep")];
+    for (xml, want) in cases.iter().chain(&more) {
         let e = try_xml(xml, &[]).expect_err(xml);
         assert!(e.contains(want), "\n{xml}\ngave: {e}\nwanted: {want}");
     }

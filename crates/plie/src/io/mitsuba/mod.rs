@@ -27,6 +27,7 @@ pub mod xml;
 
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
+use std::rc::Rc;
 
 use glam::{Mat4, Vec2, Vec3};
 
@@ -43,6 +44,8 @@ use crate::scene::{Camera, Material, MaterialId, Scene, SceneBuilder, TextureId}
 
 /// The most triangles a Mitsuba scene may expand to (instances included).
 pub const MAX_TRIANGLES: usize = 50_000_000;
+/// How deep BSDFs may nest (`twosided`, `coating`, `mask` ...).
+const MAX_BSDF_NESTING: usize = 16;
 
 /// Loads the Mitsuba scene file at `path` (see the module doc).
 pub fn load_mitsuba(path: &Path) -> Result<Scene> {
@@ -67,6 +70,7 @@ pub fn load_mitsuba_with(path: &Path, opts: LoadOptions) -> Result<Scene> {
         ids,
         b: SceneBuilder::new(&scene_name(path)),
         bsdfs: HashMap::new(),
+        meshes: HashMap::new(),
         materials: HashMap::new(),
         textures: HashMap::new(),
         emissive: Vec::new(),
@@ -144,6 +148,8 @@ struct Loader<'a> {
     opts: LoadOptions,
     ids: HashMap<String, &'a Elem>,
     b: SceneBuilder,
+    /// Mesh files read so far, by (shape type, file, flip_tex_coords, shape_index).
+    meshes: HashMap<(String, PathBuf, bool, usize), Rc<TriMesh>>,
     /// Converted BSDFs by element address.
     bsdfs: HashMap<*const Elem, Bsdf>,
     /// Materials by (BSDF address, emission bits, textured).
@@ -218,19 +224,10 @@ impl<'a> Loader<'a> {
         }
         let mut to_world = parent * transform(e, "to_world")?;
         let (mesh, analytic) = match ty {
-            "obj" => {
-                let flip = boolean(e, "flip_tex_coords", true)?;
-                (self.reading(e, super::obj::load_obj_mesh(&self.file(e, "filename")?, flip))?, false)
-            }
-            "ply" => (self.reading(e, super::ply::load_ply(&self.file(e, "filename")?))?, false),
-            "serialized" => {
-                let index = integer(e, "shape_index", 0)?;
-                let index = usize::try_from(index).map_err(|_| e.error(format!("shape_index {index} is negative")))?;
-                (self.reading(e, super::serialized::load_serialized(&self.file(e, "filename")?, index))?, false)
-            }
-            "rectangle" => (shapes::rectangle(), true),
-            "cube" => (shapes::cube(), true),
-            "disk" => (shapes::disk(), true),
+            "obj" | "ply" | "serialized" => (self.mesh_file(e, ty)?, false),
+            "rectangle" => (Rc::new(shapes::rectangle()), true),
+            "cube" => (Rc::new(shapes::cube()), true),
+            "disk" => (Rc::new(shapes::disk()), true),
             "sphere" => {
                 let center = props::point(e, "center", Vec3::ZERO)?;
                 let radius = float(e, "radius", 1.0)?;
@@ -238,7 +235,7 @@ impl<'a> Loader<'a> {
                     return Err(e.error(format!("radius {radius} must be positive")));
                 }
                 to_world = to_world * Mat4::from_translation(center) * Mat4::from_scale(Vec3::splat(radius));
-                (shapes::sphere(), true)
+                (Rc::new(shapes::sphere()), true)
             }
             t => {
                 return Err(e.error(format!(
@@ -343,10 +340,38 @@ impl<'a> Loader<'a> {
         Ok(())
     }
 
+    /// The mesh of an `obj`, `ply` or `serialized` shape, read once per file (instances reuse it).
+    fn mesh_file(&mut self, e: &Elem, ty: &str) -> Result<Rc<TriMesh>> {
+        let path = self.file(e, "filename")?;
+        let flip = boolean(e, "flip_tex_coords", true)?;
+        let index = integer(e, "shape_index", 0)?;
+        let index = usize::try_from(index).map_err(|_| e.error(format!("shape_index {index} is negative")))?;
+        let key = (ty.to_string(), path.clone(), flip, index);
+        if let Some(m) = self.meshes.get(&key) {
+            return Ok(m.clone());
+        }
+        let mesh = Rc::new(match ty {
+            "obj" => self.reading(e, super::obj::load_obj_mesh(&path, flip))?,
+            "ply" => self.reading(e, super::ply::load_ply(&path))?,
+            _ => self.reading(e, super::serialized::load_serialized(&path, index))?,
+        });
+        self.meshes.insert(key, mesh.clone());
+        Ok(mesh)
+    }
+
     /// Converts a BSDF (memoised per element, so each is reported once).
     fn bsdf(&mut self, e: &'a Elem) -> Result<Bsdf> {
+        self.bsdf_nested(e, 0)
+    }
+
+    /// [`Loader::bsdf`] at nesting `depth` (a BSDF that contains itself through a `<ref>` would
+    /// otherwise recurse without end).
+    fn bsdf_nested(&mut self, e: &'a Elem, depth: usize) -> Result<Bsdf> {
         if let Some(b) = self.bsdfs.get(&(e as *const Elem)) {
             return Ok(b.clone());
+        }
+        if depth > MAX_BSDF_NESTING {
+            return Err(e.error(format!("BSDFs nest more than {MAX_BSDF_NESTING} levels deep (one contains itself?)")));
         }
         let name = e.attr("id").map(str::to_string).unwrap_or_else(|| format!("{} line {}", e.file.display(), e.line));
         let ty = e.need("type")?;
@@ -366,7 +391,7 @@ impl<'a> Loader<'a> {
             }
             "twosided" => {
                 let inner = nested(self)?;
-                Bsdf { name: name.clone(), ..self.bsdf(inner)? }
+                Bsdf { name: name.clone(), ..self.bsdf_nested(inner, depth + 1)? }
             }
             "plastic" | "roughplastic" | "phong" | "ward" | "modifiedphong" => {
                 let (albedo, texture) = self.reflectance(e, "diffuse_reflectance")?;
@@ -385,7 +410,7 @@ impl<'a> Loader<'a> {
             "coating" | "roughcoating" | "bumpmap" | "normalmap" | "mask" | "blendbsdf" | "mixturebsdf" => {
                 change(self, "its nested BSDF");
                 let inner = nested(self)?;
-                Bsdf { name: name.clone(), ..self.bsdf(inner)? }
+                Bsdf { name: name.clone(), ..self.bsdf_nested(inner, depth + 1)? }
             }
             "dielectric" | "roughdielectric" | "thindielectric" | "null" | "polarizer" | "retarder" => {
                 Bsdf { name: format!("{name} ({ty})"), albedo: Vec3::ZERO, texture: None, dropped: true }

@@ -23,6 +23,8 @@ pub const MAX_XML_BYTES: u64 = 256 << 20;
 pub const MAX_INCLUDE_DEPTH: usize = 8;
 /// The most elements of a scene, includes together.
 pub const MAX_ELEMENTS: usize = 1 << 20;
+/// How deep elements may nest (real scenes nest a few levels; a deeper file is hostile).
+pub const MAX_NESTING: usize = 64;
 
 /// One XML element with its attributes (after substitution) and children.
 #[derive(Clone, Debug)]
@@ -123,7 +125,7 @@ impl Ctx {
             };
             self.params.entry(name.to_string()).or_insert_with(|| value.to_string());
         }
-        let mut out = self.convert(root, &file, &line)?;
+        let mut out = self.convert(root, &file, &line, 0)?;
         let mut children = Vec::with_capacity(out.children.len());
         for c in std::mem::take(&mut out.children) {
             if c.tag != "include" {
@@ -150,15 +152,16 @@ impl Ctx {
         n: roxmltree::Node,
         file: &Rc<PathBuf>,
         line: &dyn Fn(roxmltree::Node) -> usize,
+        depth: usize,
     ) -> Result<Elem> {
         self.elements += 1;
         let at = line(n);
+        let limit = |message: String| Error::Parse { path: (**file).clone(), line: Some(at), message };
         if self.elements > MAX_ELEMENTS {
-            return Err(Error::Parse {
-                path: (**file).clone(),
-                line: Some(at),
-                message: format!("more than {MAX_ELEMENTS} elements"),
-            });
+            return Err(limit(format!("more than {MAX_ELEMENTS} elements")));
+        }
+        if depth > MAX_NESTING {
+            return Err(limit(format!("elements nest more than {MAX_NESTING} levels deep")));
         }
         let mut attrs = Vec::new();
         for a in n.attributes() {
@@ -174,7 +177,7 @@ impl Ctx {
         }
         let mut children = Vec::new();
         for c in n.children().filter(|c| c.is_element()) {
-            children.push(self.convert(c, file, line)?);
+            children.push(self.convert(c, file, line, depth + 1)?);
         }
         Ok(Elem { tag: n.tag_name().name().to_string(), attrs, children, file: file.clone(), line: at })
     }
