@@ -96,3 +96,53 @@ pub struct RoundStats {
     /// Seconds from the start of the construction to the end of the round.
     pub seconds: f64,
 }
+
+impl std::fmt::Display for BuildStats {
+    /// The figures as lines of text, one per stage (what `plie build` prints, without the file).
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        writeln!(f, "leaves          {} ({:.3} s octree)", self.leaves, self.octree_seconds)?;
+        writeln!(
+            f,
+            "data objects    {} of {} (leaf, face, light); {} without: the face cannot see the light",
+            self.records, self.faces_considered, self.no_record_face_cannot_see_light
+        )?;
+        writeln!(
+            f,
+            "blockers        {} in all, {:.1} per record (max {}), {} candidates clipped ({:.3} s)",
+            self.blockers_total, self.blockers_mean, self.blockers_max, self.candidates_clipped, self.blockers_seconds
+        )?;
+        writeln!(
+            f,
+            "scene records   {} answered by the scene BVH ({} over the memory budget)",
+            self.records_scene, self.records_over_budget
+        )?;
+        writeln!(
+            f,
+            "regions         {} records removed (fully in umbra); of those kept, {} with umbra, {} with penumbra",
+            self.records_removed_umbra, self.records_with_umbra, self.records_with_penumbra
+        )?;
+        writeln!(
+            f,
+            "propagation     {} records removed without computing their blockers ({} candidates tested, {:.3} s)",
+            self.records_removed_propagation, self.propagation_tests, self.propagation_seconds
+        )?;
+        if let Some(u) = self.unrefined {
+            writeln!(
+                f,
+                "refinement      {} rounds: leaves {} -> {}, records {} -> {}, blockers {} -> {}",
+                self.refine_rounds,
+                u.leaves,
+                self.leaves,
+                u.records,
+                self.records,
+                u.blockers_total,
+                self.blockers_total
+            )?;
+        }
+        writeln!(
+            f,
+            "face grids      {} records with a grid, {} cells ({} fully lit, {} umbra)",
+            self.grids, self.grid_cells, self.grid_cells_lit, self.grid_cells_umbra
+        )
+    }
+}
