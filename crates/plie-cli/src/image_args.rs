@@ -3,16 +3,17 @@
 
 use anyhow::{bail, Result};
 use plie::render::RenderSettings;
+use plie::Scene;
 
 /// Options that set the rendered image.
 #[derive(clap::Args, Clone, Debug)]
 pub struct ImageArgs {
-    /// Image width in pixels (1 to 32768).
-    #[arg(long, default_value_t = 398, value_parser = clap::value_parser!(u32).range(1..=32768))]
-    pub width: u32,
-    /// Image height in pixels (1 to 32768).
-    #[arg(long, default_value_t = 398, value_parser = clap::value_parser!(u32).range(1..=32768))]
-    pub height: u32,
+    /// Image width in pixels (1 to 32768). Default: the scene file's own (a Mitsuba film), else 398.
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=32768))]
+    pub width: Option<u32>,
+    /// Image height in pixels (1 to 32768). Default: the scene file's own (a Mitsuba film), else 398.
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=32768))]
+    pub height: Option<u32>,
     /// K: K x K regular eye rays per pixel.
     #[arg(long, default_value_t = 2, value_name = "K")]
     pub eye_rays: u32,
@@ -28,12 +29,26 @@ pub struct ImageArgs {
     pub exposure: f32,
 }
 
+/// The image size without a scene size or an option (SPEC §6, the thesis' images).
+pub const DEFAULT_SIZE: u32 = 398;
+
 impl ImageArgs {
-    /// The validated render settings (and a finite exposure).
+    /// Sets the image size of `settings` for `scene`: each option given, else the scene's own size
+    /// (a Mitsuba film), else [`DEFAULT_SIZE`].
+    pub fn size_for(&self, settings: &mut RenderSettings, scene: &Scene) -> Result<()> {
+        let (w, h) = scene.image_size.unwrap_or((DEFAULT_SIZE, DEFAULT_SIZE));
+        settings.width = self.width.unwrap_or(w);
+        settings.height = self.height.unwrap_or(h);
+        settings.validate()?;
+        Ok(())
+    }
+
+    /// The validated render settings (and a finite exposure), with the image size given, or 398 x 398
+    /// until [`ImageArgs::size_for`] knows the scene.
     pub fn settings(&self) -> Result<RenderSettings> {
         let s = RenderSettings {
-            width: self.width,
-            height: self.height,
+            width: self.width.unwrap_or(DEFAULT_SIZE),
+            height: self.height.unwrap_or(DEFAULT_SIZE),
             eye_rays: self.eye_rays,
             shadow_rays: self.shadow_rays,
             seed: self.seed,

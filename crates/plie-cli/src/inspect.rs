@@ -15,7 +15,7 @@ use plie::octree::{Dir, Octree};
 use serde_json::{json, Value};
 
 use crate::image_args::ImageArgs;
-use crate::plie_args::{load_or_build, Loaded, PlieArgs};
+use crate::plie_args::{load_file, load_or_build, Loaded, PlieArgs};
 use crate::progress::Bar;
 use crate::scene_arg::{parse_vec3, CameraArgs, SceneArgs};
 
@@ -63,7 +63,8 @@ pub struct Args {
     threads: Option<usize>,
     #[command(flatten)]
     params: PlieArgs,
-    /// Inspect this P-LIE file (from `plie build`) instead of building one.
+    /// Inspect this P-LIE file (from `plie build`) instead of building one; its build parameters come
+    /// from the file (an option given that contradicts it is an error).
     #[arg(long, value_name = "FILE.plie")]
     plie: Option<PathBuf>,
     /// No progress bar, no description of the inspected cell on stderr.
@@ -89,7 +90,7 @@ fn output_kind(path: &Path) -> Result<Output> {
     Ok(kind)
 }
 
-pub fn run(a: &Args) -> Result<()> {
+pub fn run(a: &Args, matches: &clap::ArgMatches) -> Result<()> {
     crate::scenes::set_threads(a.threads)?;
     if a.output.is_none() && !a.summary {
         bail!("nothing to do: give -o OUT (.png, .gltf, .glb) with --cell X,Y,Z, or --summary");
@@ -103,7 +104,7 @@ pub fn run(a: &Args) -> Result<()> {
         crate::checks::output_is_not_input(out, &inputs)?;
     }
     let face: Option<Dir> = a.face.as_deref().map(str::parse).transpose().map_err(anyhow::Error::msg)?;
-    let settings = a.image.settings()?;
+    let mut settings = a.image.settings()?;
     if !(a.line_width.is_finite() && a.line_width > 0.0) {
         bail!("--line-width must be a positive number of pixels");
     }
@@ -113,9 +114,13 @@ pub fn run(a: &Args) -> Result<()> {
         crate::scene_arg::warn_about(&scene);
     }
     let camera = a.camera.camera(&scene)?;
+    a.image.size_for(&mut settings, &scene)?;
     let params = a.params.params(false)?;
     let bar = Bar::new(a.quiet || a.json);
-    let Loaded { octree, plie, .. } = load_or_build(&scene, params, a.plie.as_deref(), &bar)?;
+    let Loaded { octree, plie, .. } = match a.plie.as_deref() {
+        Some(file) => load_file(&scene, file, &a.params, matches)?,
+        None => load_or_build(&scene, params, None, &bar)?,
+    };
     let inspector = Inspector::new(&scene, &octree, &plie)?;
     let light = a.light.map(|i| inspector.light(i)).transpose()?;
     let leaf = a.cell.map(|p| inspector.leaf_at(p)).transpose()?;
@@ -137,11 +142,11 @@ pub fn run(a: &Args) -> Result<()> {
             Output::Png => {
                 let style = OverlayStyle { line_px: a.line_width, exposure_ev: a.image.exposure };
                 let out = render_inspection(&scene, &octree, ins, &camera, &settings, &style, &bar)?;
-                plie::io::save_image(path, a.image.width, a.image.height, &out.pixels)
+                plie::io::save_image(path, settings.width, settings.height, &out.pixels)
                     .with_context(|| format!("cannot write {}", path.display()))?;
             }
             Output::Gltf => {
-                let aspect = a.image.width as f32 / a.image.height as f32;
+                let aspect = settings.width as f32 / settings.height as f32;
                 save_inspection_gltf(path, &scene, &octree, ins, Some((&camera, aspect)))
                     .with_context(|| format!("cannot write {}", path.display()))?;
             }

@@ -22,7 +22,7 @@ mod scene_arg;
 mod scenes;
 mod verify;
 
-use clap::{Parser, Subcommand};
+use clap::{CommandFactory, FromArgMatches, Parser, Subcommand};
 
 /// Exact soft shadows from area lights with Preprocessed Local Illumination Environments.
 #[derive(Parser)]
@@ -50,8 +50,9 @@ enum Command {
 }
 
 fn main() {
-    let cli = match Cli::try_parse() {
-        Ok(cli) => cli,
+    let parsed = Cli::command().try_get_matches().and_then(|m| Cli::from_arg_matches(&m).map(|cli| (cli, m)));
+    let (cli, matches) = match parsed {
+        Ok(parsed) => parsed,
         Err(e) if e.use_stderr() => {
             // One line: clap's first paragraph (the problem), without the usage and tips that follow.
             let text = e.render().to_string();
@@ -61,11 +62,13 @@ fn main() {
         }
         Err(e) => e.exit(),
     };
+    // The subcommand's matches: which options were given explicitly (`plie render --plie`).
+    let sub = matches.subcommand().map(|(_, m)| m.clone()).unwrap_or_default();
     let result = match cli.command {
         Command::Scenes(a) => scenes::run(&a),
-        Command::Render(a) => render::run(&a),
+        Command::Render(a) => render::run(&a, &sub),
         Command::Build(a) => build::run(&a),
-        Command::Inspect(a) => inspect::run(&a),
+        Command::Inspect(a) => inspect::run(&a, &sub),
         Command::Bench(a) => bench::run(&a),
         Command::Verify(a) => verify::run(&a),
     };

@@ -6,6 +6,8 @@ use std::path::Path;
 use std::time::Instant;
 
 use anyhow::{bail, Context, Result};
+use clap::parser::ValueSource;
+use clap::ArgMatches;
 use plie::construct::refine::{MaxBlockers, RefineParams};
 use plie::lie::Plie;
 use plie::lie::{Grids, PlieParams, Propagation, Regions};
@@ -138,6 +140,109 @@ impl PlieArgs {
             max_split_depth: self.max_split_depth,
         })
     }
+}
+
+/// The spelling of the refinement criteria on the command line (`none` when off).
+fn refine_words(r: &RefineParams) -> String {
+    let mut words = Vec::new();
+    match (r.umbra_full, r.umbra_free) {
+        (true, true) => words.push("umbra"),
+        (true, false) => words.push("umbra-full"),
+        (false, true) => words.push("umbra-free"),
+        (false, false) => {}
+    }
+    if r.blockers.is_some() {
+        words.push("blockers");
+    }
+    if words.is_empty() {
+        "none".into()
+    } else {
+        words.join(",")
+    }
+}
+
+fn max_blockers_word(m: Option<MaxBlockers>) -> String {
+    match m {
+        None => "none".into(),
+        Some(MaxBlockers::Fixed(n)) => n.to_string(),
+        Some(MaxBlockers::Adaptive) => "adaptive".into(),
+    }
+}
+
+impl PlieArgs {
+    /// Checks the options given explicitly on the command line (`matches`: the subcommand's) against
+    /// the parameters a `.plie` file was built with (issue 18: the file describes itself, so options
+    /// left at their defaults take the file's values). A contradiction is an error naming the option,
+    /// the value given and the file's value.
+    pub fn check_file_params(&self, file: &PlieParams, matches: &ArgMatches, path: &Path) -> Result<()> {
+        let given = |id: &str| matches.value_source(id) == Some(ValueSource::CommandLine);
+        // (argument id, option, the value given, the file's value)
+        let mut checks: Vec<(&str, &str, String, String)> = vec![
+            ("max_triangles", "--max-triangles", self.max_triangles.to_string(), file.max_triangles.to_string()),
+            ("max_depth", "--max-depth", self.max_depth.to_string(), file.max_depth.to_string()),
+            (
+                "max_split_depth",
+                "--max-split-depth",
+                self.max_split_depth.to_string(),
+                file.refine.max_split_depth.to_string(),
+            ),
+            (
+                "max_blockers",
+                "--max-blockers",
+                max_blockers_word(self.max_blockers),
+                max_blockers_word(file.refine.blockers),
+            ),
+            ("blocker_cap", "--blocker-cap", self.blocker_cap.to_string(), BlockerCap(file.blocker_cap).to_string()),
+        ];
+        if given("refine") {
+            let asked = RefineParams {
+                umbra_full: self
+                    .refine
+                    .iter()
+                    .any(|c| matches!(c, RefineCriterion::Umbra | RefineCriterion::UmbraFull)),
+                umbra_free: self
+                    .refine
+                    .iter()
+                    .any(|c| matches!(c, RefineCriterion::Umbra | RefineCriterion::UmbraFree)),
+                blockers: self.refine.contains(&RefineCriterion::Blockers).then_some(MaxBlockers::Adaptive),
+                max_split_depth: 0,
+            };
+            checks.push(("refine", "--refine", refine_words(&asked), refine_words(&file.refine)));
+        }
+        for (id, option, given_flag, file_has) in [
+            ("no_grids", "--no-grids", self.no_grids, file.has_grids()),
+            ("no_regions", "--no-regions", self.no_regions, file.has_regions()),
+            ("no_propagation", "--no-propagation", self.no_propagation, file.propagates()),
+        ] {
+            if given(id) && given_flag && file_has {
+                bail!(
+                    "{option} contradicts the P-LIE file {}, which was built without {option} \
+                     (leave the option out to use the file)",
+                    path.display()
+                );
+            }
+        }
+        for (id, option, mine, theirs) in checks {
+            if given(id) && mine != theirs {
+                bail!(
+                    "{option} {mine} contradicts the P-LIE file {}, which was built with {option} {theirs} \
+                     (leave the option out to use the file's value)",
+                    path.display()
+                );
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Loads the P-LIE file `path` for `scene` (its fingerprint must match) with the parameters it was
+/// built with, after checking them against the options given explicitly ([`PlieArgs::check_file_params`]).
+pub fn load_file(scene: &Scene, path: &Path, args: &PlieArgs, matches: &ArgMatches) -> Result<Loaded> {
+    let t = Instant::now();
+    let (octree, plie) = plie::io::plie_file::load_plie(path, scene, None)
+        .with_context(|| format!("cannot use P-LIE file {}", path.display()))?;
+    args.check_file_params(&plie.params, matches, path)?;
+    Ok(Loaded { octree, plie, build_seconds: None, load_seconds: Some(t.elapsed().as_secs_f64()) })
 }
 
 /// An octree and its P-LIE, loaded from a file or built.

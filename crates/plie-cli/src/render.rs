@@ -14,7 +14,7 @@ use serde_json::json;
 
 use crate::image_args::ImageArgs;
 use crate::path_args::{Integrator, PathArgs};
-use crate::plie_args::{load_or_build, PlieArgs};
+use crate::plie_args::{load_file, load_or_build, PlieArgs};
 use crate::progress::Bar;
 use crate::render_path;
 use crate::scene_arg::{CameraArgs, SceneArgs};
@@ -54,7 +54,8 @@ pub struct Args {
     #[command(flatten)]
     params: PlieArgs,
     /// Use this P-LIE file (from `plie build`) instead of building one; only the P-LIE modes (`lie`,
-    /// `umbra`, `penumbra`, `grid`) use it. The octree options must be those it was built with.
+    /// `umbra`, `penumbra`, `grid`) use it. Its build parameters come from the file: build options
+    /// can be left out, and one given that contradicts the file is an error.
     #[arg(long, value_name = "FILE.plie")]
     plie: Option<PathBuf>,
     /// Print human-readable figures on stderr (times, shadow rays, and how a P-LIE answered them).
@@ -68,7 +69,7 @@ pub struct Args {
     quiet: bool,
 }
 
-pub fn run(a: &Args) -> Result<()> {
+pub fn run(a: &Args, matches: &clap::ArgMatches) -> Result<()> {
     crate::scenes::set_threads(a.threads)?;
     plie::io::ImageFormat::from_path(&a.output)?;
     let inputs: Vec<&std::path::Path> = a.scene.file().into_iter().chain(a.plie.as_deref()).collect();
@@ -87,6 +88,7 @@ pub fn run(a: &Args) -> Result<()> {
         crate::scene_arg::warn_about(&scene);
     }
     let camera = a.camera.camera(&scene)?;
+    a.image.size_for(&mut settings, &scene)?;
 
     let t = Instant::now();
     let bvh = Bvh::build(&scene);
@@ -103,7 +105,10 @@ pub fn run(a: &Args) -> Result<()> {
     let params = a.params.params(asked == Mode::Grid)?;
     let t = Instant::now();
     let (mode, octree, plie, plie_seconds, load_plie_seconds) = if asked.needs_plie() || plie_file.is_some() {
-        let got = load_or_build(&scene, params, plie_file, &bar)?;
+        let got = match plie_file {
+            Some(file) => load_file(&scene, file, &a.params, matches)?,
+            None => load_or_build(&scene, params, None, &bar)?,
+        };
         let mode = a.visibility.unwrap_or_else(|| best_mode(&got.plie.params));
         (mode, got.octree, Some(got.plie), got.build_seconds, got.load_seconds)
     } else {
@@ -163,7 +168,7 @@ pub fn run(a: &Args) -> Result<()> {
         }
         _ => out.pixels,
     };
-    plie::io::save_image(&a.output, a.image.width, a.image.height, &pixels)
+    plie::io::save_image(&a.output, settings.width, settings.height, &pixels)
         .with_context(|| format!("cannot write {}", a.output.display()))?;
 
     let s = out.stats;
@@ -175,8 +180,8 @@ pub fn run(a: &Args) -> Result<()> {
             "triangles": scene.triangle_count(),
             "lights": scene.lights.len(),
             "visibility": mode.name(),
-            "width": a.image.width,
-            "height": a.image.height,
+            "width": settings.width,
+            "height": settings.height,
             "integrator": "direct",
             "eye_rays": settings.eye_rays,
             "shadow_rays_per_light": a.image.shadow_rays,
@@ -220,7 +225,7 @@ pub fn run(a: &Args) -> Result<()> {
         eprintln!("visibility       {mode}");
         eprintln!(
             "image            {}x{}, {}x{} eye rays/pixel, {} shadow rays/light",
-            a.image.width, a.image.height, settings.eye_rays, settings.eye_rays, a.image.shadow_rays
+            settings.width, settings.height, settings.eye_rays, settings.eye_rays, a.image.shadow_rays
         );
         eprintln!("threads          {}", rayon::current_num_threads());
         eprintln!("load             {load_seconds:.3} s");

@@ -11,12 +11,13 @@ use plie::{Camera, Scene};
 /// The option that chooses the scene.
 #[derive(clap::Args, Clone, Debug)]
 pub struct SceneArgs {
-    /// A built-in scene name (see `plie scenes`) or a scene file (.obj with its .mtl, .gltf, .glb).
+    /// A built-in scene name (see `plie scenes`) or a scene file (.obj with its .mtl, .gltf, .glb, or a
+    /// Mitsuba scene .xml).
     #[arg(long, value_name = "NAME|FILE")]
     pub scene: String,
     /// Let the scene file name files outside its own folder (absolute paths, `..`, `file:` URIs in
-    /// `mtllib` lines or glTF buffer URIs). Off by default: a scene from elsewhere cannot make plie
-    /// read other files.
+    /// `mtllib` lines, glTF buffer URIs, Mitsuba includes, meshes and textures). Off by default: a
+    /// scene from elsewhere cannot make plie read other files.
     #[arg(long)]
     pub allow_outside_paths: bool,
 }

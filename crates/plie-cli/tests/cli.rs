@@ -246,7 +246,8 @@ fn build_then_render_with_the_saved_p_lie() {
     let o = run(args(without.to_str().unwrap(), &[]));
     assert!(o.status.success(), "{}", stderr(&o));
     assert_eq!(std::fs::read(&with).unwrap(), std::fs::read(&without).unwrap());
-    // The same file used for another scene, or with other parameters: refused.
+    // The same file used for another scene, or with an option that contradicts it: refused, naming
+    // the option and both values.
     fails_with(
         &["render", "--scene", "cornell-cube-2", "-o", "/tmp/x.png", "--visibility", "lie", "--plie", f],
         "another scene",
@@ -265,7 +266,7 @@ fn build_then_render_with_the_saved_p_lie() {
             "--max-triangles",
             "50",
         ],
-        "other parameters",
+        "--max-triangles 50 contradicts the P-LIE file",
     );
     std::fs::write(dir.path().join("bad.plie"), b"PLIE").unwrap();
     let bad = dir.path().join("bad.plie");
@@ -467,11 +468,25 @@ fn build_refines_by_umbra_and_render_uses_the_refined_p_lie() {
         img("built.pfm", &["--visibility", "grid", "--refine", "umbra,blockers", "--max-blockers", "adaptive"]),
         brute
     );
-    // Loading asks for the refinement the file was built with.
+    // The file describes itself (issue 18): loading it needs none of its build options, and an option
+    // given that contradicts it is an error naming the option and both values.
+    assert_eq!(img("described.pfm", &["--visibility", "umbra", "--plie", fs]), brute);
     let x = dir.path().join("x.png");
     fails_with(
-        &["render", "--scene", "cornell-cube-5", "--visibility", "lie", "--plie", fs, "-o", x.to_str().unwrap()],
-        "other parameters",
+        &[
+            "render",
+            "--scene",
+            "cornell-cube-5",
+            "--visibility",
+            "lie",
+            "--plie",
+            fs,
+            "--refine",
+            "umbra-free",
+            "-o",
+            x.to_str().unwrap(),
+        ],
+        "--refine umbra-free contradicts the P-LIE file",
     );
     assert!(!x.exists());
 }
@@ -496,4 +511,50 @@ fn bad_refinement_options_give_one_line_errors() {
     fails_with(&with(&base, &["--refine", "umbra", "--no-regions"]), "regions");
     fails_with(&with(&base, &["--refine", "umbra", "--max-split-depth", "40"]), "depth");
     assert!(!Path::new("never.plie").exists());
+}
+
+/// Issue 18: `plie build --refine umbra -o f.plie` then `plie render --plie f.plie` and `plie inspect
+/// --plie f.plie` with no build option: the file's parameters are used. An option given explicitly
+/// that contradicts the file is an error naming the option and both values; one that agrees is fine.
+#[test]
+fn a_plie_file_describes_itself() {
+    let dir = tempfile::tempdir().unwrap();
+    let f = dir.path().join("f.plie");
+    let fs = f.to_str().unwrap();
+    let o =
+        plie(&["build", "--scene", "cornell-cube-1", "--refine", "umbra", "--max-triangles", "100", "-o", fs, "-q"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let out = dir.path().join("r.png");
+    let render = [
+        "render",
+        "--scene",
+        "cornell-cube-1",
+        "--plie",
+        fs,
+        "-o",
+        out.to_str().unwrap(),
+        "--width",
+        "16",
+        "--height",
+        "16",
+    ];
+    let o = plie(&render);
+    assert!(o.status.success(), "render --plie without build options: {}", stderr(&o));
+    let o = plie(&["inspect", "--scene", "cornell-cube-1", "--plie", fs, "--summary"]);
+    assert!(o.status.success(), "inspect --plie without build options: {}", stderr(&o));
+    let o = plie(&[&render[..], &["--max-triangles", "100", "--refine", "umbra", "--blocker-cap", "64"]].concat());
+    assert!(o.status.success(), "options that agree with the file: {}", stderr(&o));
+    for (extra, want) in [
+        (&["--max-triangles", "200"][..], "--max-triangles 200 contradicts the P-LIE file"),
+        (&["--max-triangles", "200"][..], "which was built with --max-triangles 100"),
+        (&["--blocker-cap", "none"][..], "--blocker-cap none contradicts the P-LIE file"),
+        (&["--no-grids"][..], "--no-grids contradicts the P-LIE file"),
+        (&["--max-depth", "3"][..], "built with --max-depth 10"),
+    ] {
+        fails_with(&[&render[..], extra].concat(), want);
+    }
+    fails_with(
+        &["inspect", "--scene", "cornell-cube-1", "--plie", fs, "--summary", "--no-propagation"],
+        "--no-propagation contradicts the P-LIE file",
+    );
 }

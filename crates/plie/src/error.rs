@@ -31,7 +31,7 @@ pub enum Error {
     #[error("invalid parameter: {0}")]
     InvalidParameter(String),
     /// No built-in scene has this name.
-    #[error("unknown scene '{name}' (built-in scenes: {known}); or give a path to an .obj/.gltf/.glb file")]
+    #[error("unknown scene '{name}' (built-in scenes: {known}); or give a path to an .obj/.gltf/.glb/.xml file")]
     UnknownScene {
         /// The name asked for.
         name: String,

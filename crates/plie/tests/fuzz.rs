@@ -1,4 +1,5 @@
-//! Fuzz targets for the readers of hostile input (issue 16): OBJ, MTL, glTF/GLB and `.plie`.
+//! Fuzz targets for the readers of hostile input (issue 16): OBJ, MTL, glTF/GLB and `.plie`; and (issue
+//! 18) Mitsuba XML scenes, PLY and Mitsuba serialized meshes.
 //!
 //! A small mutational fuzzer that runs in `cargo test` (cargo-fuzz needs a nightly toolchain and a
 //! sanitizer build of every dependency; this runs on stable): each target mutates its seed corpus
@@ -63,6 +64,13 @@ const TOKENS: &[&str] = &[
     "null",
     "\"uri\"",
     "\"POSITION\"",
+    "<shape type=\"ply\">",
+    "<ref id=\"g\"/>",
+    "<include filename=\"scene.xml\"/>",
+    "$r",
+    "element vertex 4294967295",
+    "property list uint uint vertex_indices",
+    "format binary_big_endian 1.0",
     "\"accessors\"",
     "\"count\"",
     "\"byteLength\"",
@@ -242,6 +250,44 @@ fn fuzz_glb() {
     fuzz("glb", &seeds, |d| load_and_build(&d.join("scene.glb")));
 }
 
+/// The files a Mitsuba seed scene names.
+fn mitsuba_files() -> Vec<(&'static str, Vec<u8>)> {
+    ["mesh.ply", "mesh-binary.ply", "mesh.serialized", "tex.png"].into_iter().map(|f| (f, seed(f))).collect()
+}
+
+#[test]
+fn fuzz_mitsuba_xml() {
+    let seeds: Vec<(&str, Vec<u8>)> =
+        std::iter::once(("scene.xml", seed("scene.xml"))).chain(mitsuba_files()).collect();
+    fuzz("mitsuba-xml", &seeds, |d| load_and_build(&d.join("scene.xml")));
+}
+
+#[test]
+fn fuzz_ply() {
+    for first in ["mesh.ply", "mesh-binary.ply"] {
+        let mut seeds: Vec<(&str, Vec<u8>)> = vec![(first, seed(first))];
+        seeds.extend(mitsuba_files().into_iter().filter(|(f, _)| *f != first));
+        seeds.push(("scene.xml", seed("scene.xml")));
+        fuzz(&format!("ply-{first}"), &seeds, |d| {
+            let _ = plie::io::ply::load_ply(&d.join(first));
+            load_and_build(&d.join("scene.xml"));
+        });
+    }
+}
+
+#[test]
+fn fuzz_serialized() {
+    let mut seeds: Vec<(&str, Vec<u8>)> = vec![("mesh.serialized", seed("mesh.serialized"))];
+    seeds.extend(mitsuba_files().into_iter().filter(|(f, _)| *f != "mesh.serialized"));
+    seeds.push(("scene.xml", seed("scene.xml")));
+    fuzz("serialized", &seeds, |d| {
+        for i in 0..3 {
+            let _ = plie::io::serialized::load_serialized(&d.join("mesh.serialized"), i);
+        }
+        load_and_build(&d.join("scene.xml"));
+    });
+}
+
 /// A `.plie` file of cornell-cube-1 (built here: the format's version may change).
 fn plie_seed() -> (plie::Scene, Vec<u8>) {
     let scene = plie::scene::builtin::load("cornell-cube-1").unwrap();
@@ -294,12 +340,18 @@ fn regressions() {
     for entry in std::fs::read_dir(&dir).unwrap() {
         let path = entry.unwrap().path();
         match path.extension().and_then(|e| e.to_str()) {
-            Some("obj" | "gltf" | "glb") => {
+            Some("obj" | "gltf" | "glb" | "xml") => {
                 let _ = plie::io::load_scene_with(&path, LoadOptions::default());
                 load_and_build(&path);
             }
             Some("plie") => {
                 let _ = load_plie(&path, &scene, None);
+            }
+            Some("ply") => {
+                let _ = plie::io::ply::load_ply(&path);
+            }
+            Some("serialized") => {
+                let _ = plie::io::serialized::load_serialized(&path, 0);
             }
             _ => continue,
         }

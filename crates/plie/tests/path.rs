@@ -16,7 +16,12 @@ use plie::{Camera, Material, Scene, SceneBuilder, TriId};
 /// A closed unit cube, every face an inward-facing light of radiance `le` and albedo `rho`.
 fn furnace(rho: f32, le: f32) -> Scene {
     let mut b = SceneBuilder::new("furnace");
-    let m = b.material(Material { name: "wall".into(), albedo: Vec3::splat(rho), emission: Vec3::splat(le) });
+    let m = b.material(Material {
+        name: "wall".into(),
+        albedo: Vec3::splat(rho),
+        emission: Vec3::splat(le),
+        texture: None,
+    });
     let c = |x: f32, y: f32, z: f32| Vec3::new(x, y, z);
     // Each face counter-clockwise seen from inside the cube (so its front faces inward).
     let faces = [

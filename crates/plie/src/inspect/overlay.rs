@@ -120,7 +120,12 @@ impl Materials {
     /// Adds the materials; emissions are divided by the exposure factor `k`.
     fn add(out: &mut Scene, k: f32) -> Materials {
         let mut add = |name: &str, albedo: Vec3, emission: Vec3| {
-            out.materials.push(Material { name: format!("inspect: {name}"), albedo, emission: emission / k });
+            out.materials.push(Material {
+                name: format!("inspect: {name}"),
+                albedo,
+                emission: emission / k,
+                texture: None,
+            });
             MaterialId(out.materials.len() as u32 - 1)
         };
         Materials {

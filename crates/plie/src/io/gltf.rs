@@ -4,7 +4,10 @@
 //! What is read: every mesh primitive of the default scene (or the first scene) with its node transform
 //! applied, in world space; modes TRIANGLES, TRIANGLE_STRIP and TRIANGLE_FAN, indexed or not; a node
 //! transform with negative determinant flips the winding (glTF rule). Material: base colour factor as
-//! albedo (textures and metallic-roughness ignored, and reported in [`Scene::warnings`]),
+//! albedo, times the `baseColorTexture` (sRGB, with its sampler's wrap modes and nearest or bilinear
+//! magnification filter, at the primitive's `TEXCOORD_n`; an image from a file in the scene's folder, a
+//! data URI or a buffer view) where the primitive has texture coordinates; emissive textures and
+//! metallic-roughness are ignored and reported in [`Scene::warnings`];
 //! `emissiveFactor` x `KHR_materials_emissive_strength` as emitted radiance;
 //! primitives without material get a grey default (albedo 0.8). The first perspective camera met in a
 //! depth-first walk of the scene becomes the scene camera (position, `-z` as view direction and `+y` as
@@ -21,12 +24,14 @@ use std::path::Path;
 use ::gltf::accessor::{DataType, Dimensions};
 use ::gltf::mesh::Mode;
 use ::gltf::{Accessor, Document, Semantic};
-use glam::{Mat4, Vec3};
+use glam::{Mat4, Vec2, Vec3};
 
 use super::input::{read_bounded, resolve_in_scene, short, LoadOptions, MAX_INPUT_BYTES};
 use super::lights::{self, EmissiveTriangle};
+use super::texture_file::decode_texture;
 use super::{material_warnings, parse_error, scene_name};
 use crate::error::{Error, Result};
+use crate::scene::texture::{Filter, Wrap};
 use crate::scene::{Camera, Material, MaterialId, Scene, SceneBuilder};
 
 /// Loads a `.gltf` or `.glb` file (see the module doc); buffers only from the file's folder.
@@ -53,6 +58,9 @@ pub fn load_gltf_with(path: &Path, opts: LoadOptions) -> Result<Scene> {
     let mut loader = Loader {
         builder: SceneBuilder::new(&scene_name(path)),
         buffers: &buffers,
+        dir: path.parent().unwrap_or(Path::new("")),
+        opts,
+        tex_coord: vec![0; doc.materials().len() + 1],
         materials: vec![None; doc.materials().len() + 1],
         emissive: Vec::new(),
         emissive_info: Vec::new(),
@@ -240,6 +248,11 @@ fn check_accessor(
 struct Loader<'a> {
     builder: SceneBuilder,
     buffers: &'a [::gltf::buffer::Data],
+    /// The scene's folder (image files) and how files are confined.
+    dir: &'a Path,
+    opts: LoadOptions,
+    /// The `TEXCOORD_n` set of each material's base colour texture.
+    tex_coord: Vec<u32>,
     /// Our material of each glTF material (last slot: the default material).
     materials: Vec<Option<(MaterialId, Material)>>,
     emissive: Vec<EmissiveTriangle>,
@@ -281,11 +294,23 @@ impl Loader<'_> {
             return Err(format!("{} indices (vertices) is not a multiple of 3 for TRIANGLES", indices.len()));
         }
         let flip = world.determinant() < 0.0;
-        let (m, mat) = self.material(prim.material())?;
+        let (mut m, mat) = self.material(prim.material())?;
+        let uvs = match mat.texture {
+            Some(_) => self.tex_coords(prim, &reader, positions.len())?,
+            None => None,
+        };
+        if mat.texture.is_some() && uvs.is_none() {
+            m = self.builder.material(Material { texture: None, ..mat.clone() });
+            let what = "baseColorTexture on a primitive without its TEXCOORD attribute: the flat colour factor is used";
+            self.ignored.push((what.to_string(), mat.name.clone()));
+        }
         for (k, t) in triangles(mode, &indices).enumerate() {
+            let t = if flip { [t[0], t[2], t[1]] } else { t };
             let [a, b, c] = t.map(|i| positions[i as usize]);
-            let (b, c) = if flip { (c, b) } else { (b, c) };
-            let id = self.builder.triangle(a, b, c, m);
+            let id = match &uvs {
+                Some(uv) => self.builder.triangle_uv([a, b, c], t.map(|i| uv[i as usize]), m),
+                None => self.builder.triangle(a, b, c, m),
+            };
             if mat.is_emissive() {
                 self.emissive.push(EmissiveTriangle { id, vertices: [a, b, c], radiance: mat.emission });
                 self.emissive_info.push((describe(mesh, prim), k));
@@ -310,10 +335,17 @@ impl Loader<'_> {
                     let what = "metallic-roughness is not rendered: the base colour is shaded as a diffuse surface";
                     self.ignored.push((what.to_string(), name.clone()));
                 }
-                if pbr.base_color_texture().is_some() || m.emissive_texture().is_some() {
-                    let what = "textures are not rendered: the flat colour factors are used";
+                if m.emissive_texture().is_some() {
+                    let what = "emissive textures are not rendered: the flat emissive factor is used";
                     self.ignored.push((what.to_string(), name.clone()));
                 }
+                let texture = match pbr.base_color_texture() {
+                    Some(info) => {
+                        self.tex_coord[slot] = info.tex_coord();
+                        Some(self.texture(info.texture()).map_err(|e| format!("material {i}: {e}"))?)
+                    }
+                    None => None,
+                };
                 let strength = m.emissive_strength().unwrap_or(1.0);
                 let emission = Vec3::from(m.emissive_factor()) * strength;
                 if !emission.is_finite() || strength.is_nan() || strength < 0.0 {
@@ -323,12 +355,81 @@ impl Loader<'_> {
                         f32::MAX
                     ));
                 }
-                Material { name, albedo: Vec3::new(base[0], base[1], base[2]).clamp(Vec3::ZERO, Vec3::ONE), emission }
+                Material {
+                    name,
+                    albedo: Vec3::new(base[0], base[1], base[2]).clamp(Vec3::ZERO, Vec3::ONE),
+                    emission,
+                    texture,
+                }
             }
         };
         let id = self.builder.material(mat.clone());
         self.materials[slot] = Some((id, mat.clone()));
         Ok((id, mat))
+    }
+
+    /// Decodes a texture's image (sRGB) with its sampler's wrap modes and filter.
+    fn texture(&mut self, t: ::gltf::Texture) -> Result<crate::scene::TextureId, String> {
+        use ::gltf::image::Source;
+        use ::gltf::texture::{MagFilter, WrappingMode};
+        let image = t.source();
+        let what = format!("image {}", image.index());
+        let (name, bytes) = match image.source() {
+            Source::View { view, .. } => {
+                let data = self.buffers.get(view.buffer().index()).map(|d| &d.0[..]).unwrap_or(&[]);
+                let end = view.offset().checked_add(view.length()).filter(|&e| e <= data.len());
+                let end = end.ok_or_else(|| format!("{what}: bufferView {} reads past its buffer", view.index()))?;
+                (what.clone(), data[view.offset()..end].to_vec())
+            }
+            Source::Uri { uri, .. } if uri.starts_with("data:") => {
+                let b64 = uri
+                    .split_once(";base64,")
+                    .map(|(_, d)| d)
+                    .ok_or_else(|| format!("{what}: a data URI without base64"))?;
+                (what.clone(), base64::decode(b64).map_err(|_| format!("{what}: the data URI is not valid base64"))?)
+            }
+            Source::Uri { uri, .. } => {
+                let decoded = urlencoding::decode(uri).map_err(|_| format!("{what}: the URI is not UTF-8"))?;
+                let file = resolve_in_scene(self.dir, &decoded, &format!("{what} URI"), self.opts)?;
+                let bytes = read_bounded(&file, MAX_INPUT_BYTES).map_err(|e| format!("{what}: {e}"))?;
+                (short(&decoded), bytes)
+            }
+        };
+        let mut tex = decode_texture(&name, bytes, true).map_err(|e| format!("{what}: {e}"))?;
+        let sampler = t.sampler();
+        let wrap = |w: WrappingMode| match w {
+            WrappingMode::Repeat => Wrap::Repeat,
+            WrappingMode::MirroredRepeat => Wrap::Mirror,
+            WrappingMode::ClampToEdge => Wrap::Clamp,
+        };
+        tex.wrap = [wrap(sampler.wrap_s()), wrap(sampler.wrap_t())];
+        tex.filter = if sampler.mag_filter() == Some(MagFilter::Nearest) { Filter::Nearest } else { Filter::Bilinear };
+        Ok(self.builder.texture(tex))
+    }
+
+    /// The primitive's texture coordinates for its material's base colour texture, if it has them.
+    fn tex_coords<'s, F>(
+        &self,
+        prim: &::gltf::Primitive,
+        reader: &::gltf::mesh::Reader<'s, 's, F>,
+        n: usize,
+    ) -> Result<Option<Vec<Vec2>>, String>
+    where
+        F: Clone + Fn(::gltf::Buffer<'s>) -> Option<&'s [u8]>,
+    {
+        let slot = prim.material().index().unwrap_or(self.tex_coord.len() - 1);
+        let set = self.tex_coord[slot];
+        let Some(acc) = prim.get(&Semantic::TexCoords(set)) else { return Ok(None) };
+        let ok = |t, d| matches!(t, DataType::F32 | DataType::U8 | DataType::U16) && d == Dimensions::Vec2;
+        check_accessor(&acc, self.buffers, "Vec2 of F32, U8 or U16", ok)?;
+        let uv: Vec<Vec2> = match reader.read_tex_coords(set) {
+            Some(r) => r.into_f32().map(Vec2::from).collect(),
+            None => return Ok(None),
+        };
+        if uv.len() != n {
+            return Err(format!("TEXCOORD_{set} has {} elements for {n} vertices", uv.len()));
+        }
+        Ok(Some(uv))
     }
 
     /// Takes the node's camera if it is perspective.

@@ -18,9 +18,14 @@ pub mod gltf_export;
 pub mod image;
 pub mod input;
 pub mod lights;
+pub mod mitsuba;
 pub mod obj;
 mod obj_lines;
 pub mod plie_file;
+pub mod ply;
+pub mod serialized;
+pub mod texture_file;
+pub mod tri_mesh;
 
 use std::path::Path;
 
@@ -32,10 +37,10 @@ use crate::error::{Error, Result};
 use crate::scene::Scene;
 
 /// The scene file extensions [`load_scene`] understands (lower case, without the dot).
-pub const SCENE_EXTENSIONS: [&str; 3] = ["obj", "gltf", "glb"];
+pub const SCENE_EXTENSIONS: [&str; 4] = ["obj", "gltf", "glb", "xml"];
 
 /// Loads a scene file, choosing the format by extension (case-insensitive): `.obj` (with its MTL
-/// files), `.gltf` or `.glb`. The scene is named after the file stem. The file's camera, if any, becomes
+/// files), `.gltf` or `.glb`, or a Mitsuba scene `.xml`. The scene is named after the file stem. The file's camera, if any, becomes
 /// the scene camera; otherwise [`Scene::camera`] is `None`. Files the scene names are read only from
 /// its own folder ([`LoadOptions::default`]).
 pub fn load_scene(path: &Path) -> Result<Scene> {
@@ -48,6 +53,7 @@ pub fn load_scene_with(path: &Path, opts: LoadOptions) -> Result<Scene> {
     match ext.as_str() {
         "obj" => obj::load_obj_with(path, opts),
         "gltf" | "glb" => gltf::load_gltf_with(path, opts),
+        "xml" => mitsuba::load_mitsuba_with(path, opts),
         _ => Err(parse_error(
             path,
             None,

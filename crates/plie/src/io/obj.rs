@@ -1,15 +1,20 @@
 //! Wavefront OBJ + MTL scenes (SPEC §1 scene model), read with `tobj` through a checking line filter
 //! (`obj_lines.rs`).
 //!
-//! What is read: `v` (with an optional `w`, which divides; vertex colours are ignored), `f` (polygons
-//! are fan-triangulated; positive and negative indices; texture and normal indices are ignored), `o`/`g`,
-//! `mtllib` (paths relative to the OBJ; several names on one line are allowed), `usemtl`, and in the MTL
-//! files `newmtl`, `Kd` (diffuse albedo, clamped to [0, 1]) and `Ke` (emitted radiance). A repeated
-//! `Kd` in one material: the last one counts, as in other OBJ readers. Everything else (normals, texture
-//! coordinates, `Ka`, `Ks`, `d`, `Tr`, maps, lines, points) is ignored: surfaces are opaque and
-//! Lambertian; a non-zero `Ks` and a `map_Kd` (which would change how the scene looks) are reported
-//! in [`Scene::warnings`]. An emissive triangle emits on the side its counter-clockwise winding faces;
-//! vertex normals are not used. Emissive triangles are grouped into lights by [`super::lights`].
+//! What is read: `v` (with an optional `w`, which divides; vertex colours are ignored), `vt` (texture
+//! coordinates; a malformed one reads as (0, 0), as they were once ignored), `f` (polygons are
+//! fan-triangulated; positive and negative indices; texture indices are kept where every corner of the
+//! face has a valid one; normal indices are ignored), `o`/`g`, `mtllib` (paths relative to the OBJ;
+//! several names on one line are allowed), `usemtl`, and in the MTL files `newmtl`, `Kd` (diffuse
+//! albedo, clamped to [0, 1]), `Ke` (emitted radiance) and `map_Kd` (a texture the albedo is multiplied
+//! by, issue 18: sRGB, bilinear, repeating; `v` flipped, since OBJ puts `v = 0` at the image's bottom;
+//! its file confined to the scene's folder like `mtllib`). A repeated `Kd` in one material: the last
+//! one counts, as in other OBJ readers. Everything else (normals, `Ka`, `Ks`, `d`, `Tr`, other maps,
+//! lines, points) is ignored: surfaces are opaque and Lambertian; a non-zero `Ks`, a missing `map_Kd`
+//! file and a `map_Kd` on faces without texture coordinates (which would change how the scene looks)
+//! are reported in [`Scene::warnings`]. An emissive triangle emits on the side its counter-clockwise
+//! winding faces; vertex normals are not used. Emissive triangles are grouped into lights by
+//! [`super::lights`]. [`load_obj_mesh`] reads an OBJ's geometry alone (for Mitsuba scenes).
 //!
 //! Faces before any `usemtl` get a grey default material (albedo 0.8). Everything that would make a
 //! scene silently differ from its file is an error naming the file and line: a `mtllib` that cannot be
@@ -23,11 +28,13 @@ use std::io::BufReader;
 use std::path::{Path, PathBuf};
 use std::str::SplitWhitespace;
 
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 
 use super::input::{open_regular, resolve_in_scene, short, LoadOptions, MAX_INPUT_BYTES};
 use super::lights::{self, EmissiveTriangle};
 use super::obj_lines::{parse_finite, rest_after_keyword, strip_comment, LineFilter, LineRules};
+use super::texture_file::load_texture;
+use super::tri_mesh::TriMesh;
 use super::{material_warnings, parse_error, scene_name};
 use crate::error::{Error, Result};
 use crate::scene::{Material, MaterialId, Scene, SceneBuilder};
@@ -41,7 +48,7 @@ pub fn load_obj(path: &Path) -> Result<Scene> {
 /// [`load_obj`] with options.
 pub fn load_obj_with(path: &Path, opts: LoadOptions) -> Result<Scene> {
     let file = open_regular(path, MAX_INPUT_BYTES)?;
-    let libs = RefCell::new(Libraries::default());
+    let libs = RefCell::new(Libraries { opts, ..Default::default() });
     let dir = path.parent().unwrap_or(Path::new(""));
     let mut reader = LineFilter::new(BufReader::new(file), ObjRules::new(&libs));
     let options = tobj::LoadOptions { triangulate: true, single_index: true, ignore_points: true, ignore_lines: true };
@@ -58,9 +65,56 @@ pub fn load_obj_with(path: &Path, opts: LoadOptions) -> Result<Scene> {
         return Err(parse_error(path, None, "the file is empty".into()));
     }
     let has_mtllib = !libs.borrow().names.is_empty() || !libs.borrow().libs.is_empty();
-    let mut scene = build(path, &models, &materials, &reader.rules.tri_lines, has_mtllib)?;
-    scene.warnings = material_warnings(&libs.borrow().ignored);
+    let textures = std::mem::take(&mut libs.borrow_mut().textures);
+    let mut ignored = std::mem::take(&mut libs.borrow_mut().ignored);
+    let mut scene = build(path, &models, &materials, &reader.rules.tri_lines, has_mtllib, &textures, &mut ignored)?;
+    scene.warnings = material_warnings(&ignored);
     Ok(scene)
+}
+
+/// Loads an OBJ file's geometry only (a mesh a Mitsuba scene names): positions, faces and texture
+/// coordinates (`v` flipped, so `(0, 0)` is the image's top-left corner as [`crate::scene::texture`]
+/// expects, unless `flip_v` is false); `mtllib`, `usemtl` and materials are ignored.
+pub fn load_obj_mesh(path: &Path, flip_v: bool) -> Result<TriMesh> {
+    let file = open_regular(path, MAX_INPUT_BYTES)?;
+    let libs = RefCell::new(Libraries::default());
+    let mut rules = ObjRules::new(&libs);
+    rules.mesh_only = true;
+    let mut reader = LineFilter::new(BufReader::new(file), rules);
+    let options = tobj::LoadOptions { triangulate: true, single_index: true, ignore_points: true, ignore_lines: true };
+    let result = tobj::load_obj_buf(&mut reader, &options, |_| Err(tobj::LoadError::OpenFileFailed));
+    if let Some((line, message)) = reader.error() {
+        return Err(parse_error(path, Some(*line), message.clone()));
+    }
+    let (models, _) = result.map_err(|e| parse_error(path, Some(reader.line()), e.to_string()))?;
+    let mut mesh = TriMesh::default();
+    let all_uv = models.iter().all(|m| has_uvs(&m.mesh));
+    for model in &models {
+        let m = &model.mesh;
+        let base = mesh.positions.len() as u32;
+        mesh.positions.extend(m.positions.chunks_exact(3).map(|p| Vec3::new(p[0], p[1], p[2])));
+        if all_uv {
+            mesh.uvs
+                .extend(m.texcoords.chunks_exact(2).map(|t| Vec2::new(t[0], if flip_v { 1.0 - t[1] } else { t[1] })));
+        }
+        let n = mesh.positions.len() as u32;
+        for t in m.indices.chunks_exact(3) {
+            let t = [t[0] + base, t[1] + base, t[2] + base];
+            if t.iter().any(|&i| i >= n) {
+                return Err(parse_error(path, None, "face vertex index out of range".into()));
+            }
+            mesh.triangles.push(t);
+        }
+    }
+    if mesh.triangles.is_empty() {
+        return Err(parse_error(path, None, "no faces: the file defines no triangles".into()));
+    }
+    Ok(mesh)
+}
+
+/// True if `tobj` gave every vertex of the mesh texture coordinates.
+fn has_uvs(m: &tobj::Mesh) -> bool {
+    !m.texcoords.is_empty() && m.texcoords.len() / 2 == m.positions.len() / 3
 }
 
 /// State shared by the OBJ filter and the MTL loader.
@@ -76,19 +130,27 @@ struct Libraries {
     error: Option<Error>,
     /// MTL statements read but not rendered: (what, material).
     ignored: Vec<(String, String)>,
+    /// `map_Kd` textures: (material, file), the file resolved inside the scene's folder.
+    textures: Vec<(String, PathBuf)>,
+    /// How files named in the MTL files are confined.
+    opts: LoadOptions,
 }
 
 /// Checks OBJ lines (module doc) and keeps what the loader needs to name lines later.
 struct ObjRules<'a> {
     libs: &'a RefCell<Libraries>,
     vertices: usize,
+    /// Texture coordinates (`vt`) so far.
+    texcoords: usize,
+    /// Geometry only (a mesh a Mitsuba scene names): `mtllib` and `usemtl` are dropped.
+    mesh_only: bool,
     /// The line of every triangle `tobj` will produce, in order.
     tri_lines: Vec<u32>,
 }
 
 impl<'a> ObjRules<'a> {
     fn new(libs: &'a RefCell<Libraries>) -> Self {
-        ObjRules { libs, vertices: 0, tri_lines: Vec::new() }
+        ObjRules { libs, vertices: 0, texcoords: 0, mesh_only: false, tri_lines: Vec::new() }
     }
 
     fn vertex(&mut self, words: SplitWhitespace, out: &mut String) -> Result<(), String> {
@@ -124,22 +186,59 @@ impl<'a> ObjRules<'a> {
         Ok(())
     }
 
+    fn texcoord(&mut self, words: SplitWhitespace, out: &mut String) -> Result<(), String> {
+        self.texcoords += 1;
+        let n = self.texcoords;
+        let tokens: Vec<&str> = words.take(4).collect();
+        let what = || format!("texture coordinate {n}");
+        // Texture coordinates were ignored before textures were read: a malformed one still loads,
+        // as (0, 0), so that every later index keeps its meaning.
+        let (u, v) = match tokens[..] {
+            [u] => (parse_finite(u, what).unwrap_or(0.0), 0.0),
+            [u, v, ..] => (parse_finite(u, what).unwrap_or(0.0), parse_finite(v, what).unwrap_or(0.0)),
+            _ => (0.0, 0.0),
+        };
+        let _ = write!(out, "vt {u} {v}");
+        Ok(())
+    }
+
     fn face(&mut self, line: usize, words: SplitWhitespace, out: &mut String) -> Result<(), String> {
         let v = self.vertices as u64;
-        out.push('f');
-        let mut k = 0usize;
+        let t = self.texcoords as u64;
+        let resolve = |index: &str, n: u64, what: &str, token: &str| -> Result<u64, String> {
+            let i: i64 = index.parse().map_err(|_| format!("malformed {what} index '{}' in a face", short(token)))?;
+            match i {
+                0 => Err(format!("{what} index 0 in a face (OBJ indices start at 1)")),
+                i if i > 0 && i as u64 <= n => Ok(i as u64),
+                i if i < 0 && i.unsigned_abs() <= n => Ok(n + 1 - i.unsigned_abs()),
+                i => Err(format!("{what} index {i} out of range: {n} vertices are defined before this line")),
+            }
+        };
+        let mut corners: Vec<(u64, Option<u64>)> = Vec::new();
         for token in words {
-            let index = token.split('/').next().unwrap_or("");
-            let i: i64 = index.parse().map_err(|_| format!("malformed vertex index '{}' in a face", short(token)))?;
-            let absolute = match i {
-                0 => return Err("vertex index 0 in a face (OBJ indices start at 1)".into()),
-                i if i > 0 && i as u64 <= v => i as u64,
-                i if i < 0 && i.unsigned_abs() <= v => v + 1 - i.unsigned_abs(),
-                i => return Err(format!("vertex index {i} out of range: {v} vertices are defined before this line")),
+            let mut parts = token.split('/');
+            let absolute = resolve(parts.next().unwrap_or(""), v, "vertex", token)?;
+            // A texture index that does not resolve leaves the face without texture coordinates.
+            let uv = match parts.next() {
+                Some(s) if !s.is_empty() => resolve(s, t, "texture coordinate", token).ok(),
+                _ => None,
             };
-            let _ = write!(out, " {absolute}");
-            k += 1;
+            corners.push((absolute, uv));
         }
+        // Texture indices only when every corner has one, so tobj's arrays stay parallel.
+        let with_uv = corners.iter().all(|c| c.1.is_some());
+        out.push('f');
+        for (p, uv) in &corners {
+            match uv {
+                Some(uv) if with_uv => {
+                    let _ = write!(out, " {p}/{uv}");
+                }
+                _ => {
+                    let _ = write!(out, " {p}");
+                }
+            }
+        }
+        let k = corners.len();
         if k < 3 {
             return Err(format!("face with {k} vertices; a face needs at least 3"));
         }
@@ -174,6 +273,8 @@ impl LineRules for ObjRules<'_> {
         let Some(keyword) = words.next() else { return Ok(()) };
         match keyword {
             "v" => self.vertex(words, out),
+            "vt" => self.texcoord(words, out),
+            "usemtl" | "mtllib" if self.mesh_only => Ok(()),
             "f" => self.face(line, words, out),
             "usemtl" => self.usemtl(rest_after_keyword(text, keyword), out),
             "mtllib" => {
@@ -232,8 +333,13 @@ impl LineRules for MtlRules<'_> {
             }
             "map_Kd" => {
                 let file = rest_after_keyword(text, keyword).split_whitespace().last().unwrap_or("");
-                let missing = if self.dir.join(file).is_file() { "" } else { ", and the file is missing" };
-                self.ignore(format!("map_Kd textures are not rendered: the flat Kd colour is used{missing}"));
+                let opts = self.libs.borrow().opts;
+                let path = resolve_in_scene(&self.dir, file, "map_Kd", opts)?;
+                if path.is_file() {
+                    self.libs.borrow_mut().textures.push((self.material.clone(), path));
+                } else {
+                    self.ignore("map_Kd texture file is missing: the flat Kd colour is used".into());
+                }
             }
             "Kd" | "Ke" => {
                 let tokens: Vec<&str> = words.take(4).collect();
@@ -326,6 +432,7 @@ fn material(materials: &[tobj::Material], id: Option<usize>) -> Material {
             name: m.name.clone(),
             albedo: m.diffuse.map_or(Vec3::splat(0.8), Vec3::from).clamp(Vec3::ZERO, Vec3::ONE),
             emission: m.emissive.map_or(Vec3::ZERO, Vec3::from),
+            texture: None,
         },
     }
 }
@@ -337,21 +444,41 @@ fn build(
     materials: &[tobj::Material],
     tri_lines: &[u32],
     has_mtllib: bool,
+    textures: &[(String, PathBuf)],
+    ignored: &mut Vec<(String, String)>,
 ) -> Result<Scene> {
     let mut b = SceneBuilder::new(&scene_name(path));
+    let mut loaded: HashMap<&str, crate::scene::TextureId> = HashMap::new();
+    for (material, file) in textures {
+        let t = load_texture(file, true)?;
+        loaded.insert(material.as_str(), b.texture(t));
+    }
     let mut ids: HashMap<Option<usize>, (MaterialId, Material)> = HashMap::new();
     let mut emissive = Vec::new();
     let mut emissive_info = Vec::new();
     let mut t = 0usize;
     for model in models {
         let mesh = &model.mesh;
-        let (m, mat) = ids
+        let (mut m, mat) = ids
             .entry(mesh.material_id)
             .or_insert_with(|| {
-                let mat = material(materials, mesh.material_id);
+                let mut mat = material(materials, mesh.material_id);
+                mat.texture = loaded.get(mat.name.as_str()).copied();
                 (b.material(mat.clone()), mat)
             })
             .clone();
+        let uvs = (mat.texture.is_some() && has_uvs(mesh)).then_some(&mesh.texcoords);
+        if mat.texture.is_some() && uvs.is_none() {
+            m = b.material(Material { texture: None, ..mat.clone() });
+            ignored.push((
+                "map_Kd on faces without texture coordinates (vt): the flat Kd colour is used there".into(),
+                mat.name.clone(),
+            ));
+        }
+        let uv = |i: u32| {
+            let t = uvs.and_then(|t| t.get(i as usize * 2..i as usize * 2 + 2)).unwrap_or(&[0.0, 1.0]);
+            Vec2::new(t[0], 1.0 - t[1])
+        };
         let vertex = |i: u32| {
             let i = i as usize * 3;
             mesh.positions.get(i..i + 3).map(|p| Vec3::new(p[0], p[1], p[2]))
@@ -362,7 +489,10 @@ fn build(
             let (Some(a), Some(bb), Some(c)) = (vertex(tri[0]), vertex(tri[1]), vertex(tri[2])) else {
                 return Err(parse_error(path, line, "face vertex index out of range".into()));
             };
-            let id = b.triangle(a, bb, c, m);
+            let id = match uvs {
+                Some(_) => b.triangle_uv([a, bb, c], [uv(tri[0]), uv(tri[1]), uv(tri[2])], m),
+                None => b.triangle(a, bb, c, m),
+            };
             if mat.is_emissive() {
                 emissive.push(EmissiveTriangle { id, vertices: [a, bb, c], radiance: mat.emission });
                 emissive_info.push((line, mat.name.clone()));

@@ -293,7 +293,7 @@ impl Tracer<'_> {
             if max_depth >= 0 && depth as i64 + 1 >= max_depth as i64 {
                 break;
             }
-            let albedo = material.albedo;
+            let albedo = scene.albedo_at(hit.tri, hit.point);
             if albedo == Vec3::ZERO {
                 break;
             }

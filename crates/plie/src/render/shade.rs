@@ -101,7 +101,7 @@ pub fn shade_hit(
 ) -> Vec3 {
     let material = scene.material_of(hit.tri);
     let mut l = if hit.front { material.emission } else { Vec3::ZERO };
-    let f_r = material.albedo * FRAC_1_PI;
+    let f_r = scene.albedo_at(hit.tri, hit.point) * FRAC_1_PI;
     if f_r == Vec3::ZERO {
         return l;
     }

@@ -27,6 +27,10 @@ id_type!(
     LightId
 );
 id_type!(
+    /// Index of a texture in [`crate::Scene::textures`].
+    TextureId
+);
+id_type!(
     /// Index of a material in [`crate::Scene::materials`].
     MaterialId
 );

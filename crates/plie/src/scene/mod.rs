@@ -9,9 +9,11 @@ pub mod light;
 pub mod material;
 #[allow(clippy::module_inception)]
 mod scene;
+pub mod texture;
 
 pub use camera::Camera;
-pub use ids::{LightId, MaterialId, TriId};
+pub use ids::{LightId, MaterialId, TextureId, TriId};
 pub use light::Light;
 pub use material::Material;
 pub use scene::{Scene, SceneBuilder};
+pub use texture::Texture;

@@ -3,9 +3,9 @@
 //! triangles (zero area: they cannot block or be seen), counting them in
 //! [`Scene::degenerate_skipped`] so the caller can warn.
 
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 
-use super::{Camera, Light, LightId, Material, MaterialId, TriId};
+use super::{Camera, Light, LightId, Material, MaterialId, Texture, TextureId, TriId};
 use crate::error::{Error, Result};
 use crate::geometry::{Aabb, Triangle};
 
@@ -26,6 +26,13 @@ pub struct Scene {
     pub lights: Vec<Light>,
     /// The scene's own camera, if it has one.
     pub camera: Option<Camera>,
+    /// The scene's own image size (width, height), if the file gives one (a Mitsuba film).
+    pub image_size: Option<(u32, u32)>,
+    /// Textures, indexed by [`TextureId`] ([`Material::texture`]).
+    pub textures: Vec<Texture>,
+    /// Texture coordinates of each triangle's vertices, per triangle (zeros for triangles without);
+    /// empty when no triangle has any, and then [`Scene::albedo_at`] ignores textures.
+    pub tri_uv: Vec<[Vec2; 3]>,
     /// Bounding box of all triangles.
     pub bounds: Aabb,
     /// Degenerate (zero-area) triangles dropped while building.
@@ -95,6 +102,10 @@ pub struct SceneBuilder {
     materials: Vec<Material>,
     lights: Vec<PendingLight>,
     camera: Option<Camera>,
+    image_size: Option<(u32, u32)>,
+    textures: Vec<Texture>,
+    /// Per triangle once any triangle has texture coordinates (zeros for those without).
+    tri_uv: Vec<[Vec2; 3]>,
 }
 
 impl SceneBuilder {
@@ -118,7 +129,30 @@ impl SceneBuilder {
     pub fn triangle(&mut self, a: Vec3, b: Vec3, c: Vec3, m: MaterialId) -> TriId {
         self.triangles.push(Triangle::new(a, b, c));
         self.tri_material.push(m);
+        if !self.tri_uv.is_empty() {
+            self.tri_uv.push([Vec2::ZERO; 3]);
+        }
         TriId(self.triangles.len() as u32 - 1)
+    }
+
+    /// Adds a triangle with texture coordinates for its vertices.
+    pub fn triangle_uv(&mut self, v: [Vec3; 3], uv: [Vec2; 3], m: MaterialId) -> TriId {
+        self.tri_uv.resize(self.triangles.len(), [Vec2::ZERO; 3]);
+        self.triangles.push(Triangle::new(v[0], v[1], v[2]));
+        self.tri_material.push(m);
+        self.tri_uv.push(uv);
+        TriId(self.triangles.len() as u32 - 1)
+    }
+
+    /// Adds a texture and returns its id.
+    pub fn texture(&mut self, t: Texture) -> TextureId {
+        self.textures.push(t);
+        TextureId(self.textures.len() as u32 - 1)
+    }
+
+    /// Sets the scene's own image size.
+    pub fn image_size(&mut self, width: u32, height: u32) {
+        self.image_size = Some((width, height));
     }
 
     /// Adds the quad `a, b, c, d` as triangles `(a, b, c)` and `(a, c, d)`.
@@ -135,7 +169,12 @@ impl SceneBuilder {
     /// Adds a light: a convex polygon, counter-clockwise around the side it emits to, with radiance
     /// `radiance`. Its triangles (a fan) are added with an emissive material named `name`.
     pub fn light(&mut self, name: &str, polygon: &[Vec3], radiance: Vec3) -> LightId {
-        let m = self.material(Material { name: name.to_string(), albedo: Vec3::splat(0.78), emission: radiance });
+        let m = self.material(Material {
+            name: name.to_string(),
+            albedo: Vec3::splat(0.78),
+            emission: radiance,
+            texture: None,
+        });
         let first = self.triangles.len() as u32;
         for i in 1..polygon.len().saturating_sub(1) {
             self.triangle(polygon[0], polygon[i], polygon[i + 1], m);
@@ -175,6 +214,16 @@ impl SceneBuilder {
                 return bad(format!("triangle {i} uses material {} of {}", m.0, self.materials.len()));
             }
         }
+        for m in &self.materials {
+            if m.texture.is_some_and(|t| t.idx() >= self.textures.len()) {
+                return bad(format!("material '{}' uses a texture that does not exist", m.name));
+            }
+        }
+        if let Some((w, h)) = self.image_size {
+            if w == 0 || h == 0 || w > 32768 || h > 32768 {
+                return bad(format!("image size {w}x{h} must be between 1 and 32768"));
+            }
+        }
         if self.lights.is_empty() {
             return bad("the scene has no lights (no emissive triangles)".into());
         }
@@ -185,11 +234,15 @@ impl SceneBuilder {
         let mut remap = vec![u32::MAX; self.triangles.len()];
         let mut triangles = Vec::with_capacity(self.triangles.len());
         let mut tri_material = Vec::with_capacity(self.triangles.len());
+        let mut tri_uv = Vec::with_capacity(self.tri_uv.len());
         for (i, t) in self.triangles.iter().enumerate() {
             if !t.is_degenerate() {
                 remap[i] = triangles.len() as u32;
                 triangles.push(*t);
                 tri_material.push(self.tri_material[i]);
+                if let Some(uv) = self.tri_uv.get(i) {
+                    tri_uv.push(*uv);
+                }
             }
         }
         let degenerate_skipped = self.triangles.len() - triangles.len();
@@ -228,6 +281,9 @@ impl SceneBuilder {
             materials: self.materials,
             lights,
             camera: self.camera,
+            image_size: self.image_size,
+            textures: self.textures,
+            tri_uv,
             bounds,
             degenerate_skipped,
             warnings: Vec::new(),

@@ -110,11 +110,68 @@ fn metallic_roughness_and_textures_are_reported() {
     doc["materials"][1]["pbrMetallicRoughness"] = json!({"metallicFactor": 0.0});
     assert!(load_json(&doc).unwrap().warnings.is_empty());
 
-    doc["materials"][0]["pbrMetallicRoughness"]["baseColorTexture"] = json!({"index": 0});
+    doc["materials"][1]["emissiveTexture"] = json!({"index": 0});
     doc["textures"] = json!([{"source": 0}]);
-    doc["images"] = json!([{"uri": "missing.png"}]);
+    doc["images"] = json!([{"uri": format!("data:image/png;base64,{}", base64::encode(stripes_png()))}]);
     let s = load_json(&doc).unwrap();
-    assert_eq!(s.warnings, ["material 'grey': textures are not rendered: the flat colour factors are used"]);
+    assert_eq!(s.warnings, ["material 'lamp': emissive textures are not rendered: the flat emissive factor is used"]);
+}
+
+/// The 4x4 stripes texture of the Mitsuba test data: columns red, white, blue, white; the top row
+/// at half the value.
+fn stripes_png() -> Vec<u8> {
+    std::fs::read(std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/mitsuba/stripes.png")).unwrap()
+}
+
+/// The floor with `baseColorTexture` and `TEXCOORD_0` (a second buffer): the albedo at a point is the
+/// base colour factor times the sRGB-decoded texel there (glTF: uv (0, 0) is the image's top left).
+#[test]
+fn base_color_texture() {
+    let srgb = |c: f32| plie::scene::texture::srgb_to_linear(c / 255.0);
+    let uv: Vec<u8> =
+        [[0.0f32, 0.0], [0.0, 1.0], [1.0, 1.0], [1.0, 0.0]].iter().flatten().flat_map(|x| x.to_le_bytes()).collect();
+    let mut doc = embedded();
+    doc["buffers"].as_array_mut().unwrap().push(
+        json!({"uri": format!("data:application/octet-stream;base64,{}", base64::encode(&uv)), "byteLength": 32}),
+    );
+    doc["bufferViews"].as_array_mut().unwrap().push(json!({"buffer": 1, "byteOffset": 0, "byteLength": 32}));
+    doc["accessors"]
+        .as_array_mut()
+        .unwrap()
+        .push(json!({"bufferView": 2, "count": 4, "type": "VEC2", "componentType": 5126}));
+    doc["meshes"][0]["primitives"][0]["attributes"]["TEXCOORD_0"] = json!(4);
+    doc["materials"][0]["pbrMetallicRoughness"]["baseColorTexture"] = json!({"index": 0});
+    doc["textures"] = json!([{"source": 0, "sampler": 0}]);
+    doc["samplers"] = json!([{"magFilter": 9728, "wrapS": 33071, "wrapT": 33648}]);
+    doc["images"] = json!([{"uri": "stripes.png"}]);
+    let text = doc.to_string();
+    let s = load_from(&[("s.gltf", text.as_bytes()), ("stripes.png", &stripes_png())], "s.gltf").unwrap();
+    assert_eq!(s.textures.len(), 1);
+    let t = &s.textures[0];
+    assert_eq!(t.filter, plie::scene::texture::Filter::Nearest);
+    assert_eq!(t.wrap, [plie::scene::texture::Wrap::Clamp, plie::scene::texture::Wrap::Mirror]);
+    let factor = Vec3::new(0.5, 0.25, 1.0);
+    let top_left = s.albedo_at(plie::TriId(0), Vec3::new(-0.8, 0.0, -0.8));
+    assert_eq!(top_left, factor * Vec3::new(srgb(100.0), srgb(20.0), srgb(15.0)), "dark red, top row");
+    let lower = s.albedo_at(plie::TriId(0), Vec3::new(0.1, 0.0, 0.5));
+    assert_eq!(lower, factor * Vec3::new(srgb(40.0), srgb(70.0), srgb(200.0)), "blue column, lower rows");
+
+    // Without TEXCOORD_0: a warning, and the flat factor.
+    let mut flat = doc.clone();
+    flat["meshes"][0]["primitives"][0]["attributes"].as_object_mut().unwrap().remove("TEXCOORD_0");
+    let text = flat.to_string();
+    let s = load_from(&[("s.gltf", text.as_bytes()), ("stripes.png", &stripes_png())], "s.gltf").unwrap();
+    assert!(s.warnings.iter().any(|w| w.contains("without its TEXCOORD")), "{:?}", s.warnings);
+    assert_eq!(s.albedo_at(plie::TriId(0), Vec3::new(-0.8, 0.0, -0.8)), factor);
+
+    // A missing image or one outside the folder is an error naming it.
+    let text = doc.to_string();
+    let e = parse_error(load_from(&[("s.gltf", text.as_bytes())], "s.gltf"), "s.gltf", None);
+    assert!(e.contains("image 0"), "{e}");
+    doc["images"] = json!([{"uri": "../../etc/passwd"}]);
+    let text = doc.to_string();
+    let e = parse_error(load_from(&[("s.gltf", text.as_bytes())], "s.gltf"), "s.gltf", None);
+    assert!(e.contains("outside the scene's folder"), "{e}");
 }
 
 #[test]

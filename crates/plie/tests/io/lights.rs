@@ -47,7 +47,7 @@ fn check(input: &[EmissiveTriangle], lights: &[LightGroup]) {
     assert!(used.iter().all(|&u| u == 1), "{used:?}");
     // The scene builder accepts the lights too.
     let mut b = SceneBuilder::new("t");
-    let m = b.material(Material { name: "lamp".into(), albedo: Vec3::ONE, emission: Vec3::ONE });
+    let m = b.material(Material { name: "lamp".into(), albedo: Vec3::ONE, emission: Vec3::ONE, texture: None });
     for t in input {
         b.triangle(t.vertices[0], t.vertices[1], t.vertices[2], m);
     }
