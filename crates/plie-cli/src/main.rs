@@ -20,6 +20,7 @@ mod render_path;
 mod scene_arg;
 mod scenes;
 mod verify;
+mod walkthrough;
 
 use clap::{Parser, Subcommand};
 

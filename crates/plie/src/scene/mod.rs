@@ -4,6 +4,7 @@
 
 pub mod builtin;
 pub mod camera;
+pub mod camera_path;
 pub mod ids;
 pub mod light;
 pub mod material;
@@ -11,6 +12,7 @@ pub mod material;
 mod scene;
 
 pub use camera::Camera;
+pub use camera_path::CameraPath;
 pub use ids::{LightId, MaterialId, TriId};
 pub use light::Light;
 pub use material::Material;
