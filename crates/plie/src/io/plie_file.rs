@@ -124,6 +124,22 @@ pub fn save_plie(path: &Path, scene: &Scene, octree: &Octree, plie: &Plie) -> Re
 /// P-LIE was built on. Returns the octree and the P-LIE.
 pub fn load_plie(path: &Path, scene: &Scene, expect: Option<PlieParams>) -> Result<(Octree, Plie)> {
     let bytes = super::input::read_bounded(path, super::input::MAX_INPUT_BYTES)?;
+    decode_plie(&bytes, path, scene, expect)
+}
+
+/// [`load_plie`] from the bytes of a `.plie` file already in memory (e.g. fetched from a distributed
+/// object store), with the same checks; `origin` names the bytes in errors.
+pub fn load_plie_bytes(
+    bytes: &[u8],
+    origin: &str,
+    scene: &Scene,
+    expect: Option<PlieParams>,
+) -> Result<(Octree, Plie)> {
+    decode_plie(bytes, Path::new(origin), scene, expect)
+}
+
+/// Checks and decodes the bytes of a `.plie` file (see [`load_plie`]); `path` names them in errors.
+fn decode_plie(bytes: &[u8], path: &Path, scene: &Scene, expect: Option<PlieParams>) -> Result<(Octree, Plie)> {
     let bad = |m: String| Error::Parse { path: path.to_path_buf(), line: None, message: m };
     if bytes.len() < 8 || bytes[..8] != MAGIC {
         return Err(bad("not a .plie file (wrong magic bytes)".into()));
