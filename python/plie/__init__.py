@@ -29,6 +29,7 @@ from ._plie import (
     builtin_scenes,
     load_scene,
     render,
+    save_image,
 )
 
 __all__ = [
@@ -42,6 +43,7 @@ __all__ = [
     "occluded",
     "occluded_many",
     "render",
+    "save_image",
 ]
 
 __version__ = "0.1.0"

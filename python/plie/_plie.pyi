@@ -140,3 +140,6 @@ def _occluded(
     visibility: Optional[str] = None,
     env: Optional[Environment] = None,
 ) -> np.ndarray: ...
+def save_image(path: PathLike, image: np.ndarray, *, exposure: float = 0.0) -> None:
+    """Writes (H, W, 3) float32 linear radiance as `plie render -o` does (PNG, EXR or PFM by the
+    extension; PNG scaled by 2^exposure and tone-mapped), atomically."""

@@ -460,3 +460,16 @@ pub fn camera_path(text: Option<&str>, file: Option<&Path>) -> Result<CameraPath
         (None, None) => Err(invalid("camera path: give JSON text or a file".into())),
     }
 }
+
+/// Writes an image of linear radiance (row-major, top row first) as `plie render -o` does: the format
+/// of the extension (PNG tone-mapped, radiance scaled by 2^`exposure` first; EXR and PFM linear),
+/// atomically.
+pub fn save_image(path: &Path, width: u32, height: u32, rgb: &[f32], exposure: f32) -> Result<()> {
+    if !exposure.is_finite() {
+        return Err(invalid("exposure must be a finite number".into()));
+    }
+    let png = plie::io::ImageFormat::from_path(path)? == plie::io::ImageFormat::Png;
+    let k = if png && exposure != 0.0 { exposure.exp2() } else { 1.0 };
+    let pixels: Vec<Vec3> = rgb.chunks_exact(3).map(|c| Vec3::new(c[0], c[1], c[2]) * k).collect();
+    plie::io::save_image(path, width, height, &pixels)
+}

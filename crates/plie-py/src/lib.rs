@@ -9,7 +9,7 @@ mod engine;
 use std::path::PathBuf;
 use std::sync::Arc;
 
-use numpy::{PyArray1, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2};
+use numpy::{PyArray1, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2, PyReadonlyArray3};
 use pyo3::create_exception;
 use pyo3::exceptions::{PyFileNotFoundError, PyOSError, PyValueError};
 use pyo3::prelude::*;
@@ -400,6 +400,21 @@ fn _occluded<'py>(
     Ok(PyArray1::from_vec(py, out))
 }
 
+/// Writes `image` (shape (H, W, 3), linear radiance) as `plie render -o` does: PNG (tone-mapped sRGB,
+/// radiance scaled by 2^`exposure` first), EXR or PFM (linear) by the extension, atomically.
+#[pyfunction]
+#[pyo3(signature = (path, image, *, exposure=0.0))]
+fn save_image(py: Python<'_>, path: PathBuf, image: PyReadonlyArray3<'_, f32>, exposure: f32) -> PyResult<()> {
+    let a = image.as_array();
+    let shape = a.shape().to_vec();
+    if shape.len() != 3 || shape[2] != 3 {
+        return Err(PyValueError::new_err(format!("save_image: image must have shape (H, W, 3), not {shape:?}")));
+    }
+    let rgb: Vec<f32> = a.iter().copied().collect();
+    let (h, w) = (u32::try_from(shape[0]).unwrap_or(u32::MAX), u32::try_from(shape[1]).unwrap_or(u32::MAX));
+    py.detach(|| engine::save_image(&path, w, h, &rgb, exposure)).map_err(py_err)
+}
+
 /// The native module.
 #[pymodule]
 fn _plie(m: &Bound<'_, PyModule>) -> PyResult<()> {
@@ -412,5 +427,6 @@ fn _plie(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(builtin_scenes, m)?)?;
     m.add_function(wrap_pyfunction!(render, m)?)?;
     m.add_function(wrap_pyfunction!(_occluded, m)?)?;
+    m.add_function(wrap_pyfunction!(save_image, m)?)?;
     Ok(())
 }
