@@ -10,6 +10,7 @@ echo "== python: venv and tools"
 command -v python3 >/dev/null || { echo "ci: python3 not found" >&2; exit 1; }
 venv=${PLIE_VENV:-$root/target/python-ci-venv}
 python3 -m venv "$venv"
+export PATH="$venv/bin:$PATH"   # maturin's PEP 517 hook calls `maturin`
 "$venv/bin/pip" install -q --upgrade pip
 "$venv/bin/pip" install -q maturin pytest numpy
 if ! "$venv/bin/pip" install -q ray; then
