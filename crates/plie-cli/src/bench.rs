@@ -321,7 +321,8 @@ fn bench_scene(name: &str, plan: &Plan, one: &rayon::ThreadPool, bar: &Bar) -> R
     // The thesis' test-1 parameters with the default blocker cap (issue 15), as `plie build` uses.
     let thesis = PlieParams::thesis().bounded();
     thesis.octree().validate()?;
-    let (octree, octree_seconds) = timed(plan.runs, || Octree::build(&scene, thesis.octree()));
+    let (octree, octree_seconds) =
+        timed(plan.runs, || Octree::build(&scene, thesis.octree()).expect("valid octree parameters"));
     let (_, lie, b1) = build_plie(&scene, &octree, thesis, "thesis", plan.runs);
     let (_, grid, b2) = build_plie(&scene, &octree, PlieParams::default().bounded(), "grids", plan.runs);
     let no_regions = PlieParams { regions: false, ..thesis };

@@ -54,7 +54,7 @@ pub fn run(a: &Args) -> Result<()> {
     let bar = Bar::new(a.quiet || a.json);
     let t_all = Instant::now();
     let t = Instant::now();
-    let octree = Octree::build(&scene, params.octree());
+    let octree = Octree::build(&scene, params.octree())?;
     let octree_seconds = t.elapsed().as_secs_f64();
     let built = plie::construct::build_bounded(&scene, octree, params, limits, &bar)
         .context("P-LIE construction stopped by Ctrl-C; nothing was written")?;

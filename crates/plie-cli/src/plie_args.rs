@@ -161,7 +161,7 @@ pub fn load_or_build(scene: &Scene, params: PlieParams, path: Option<&Path>, bar
             .with_context(|| format!("cannot use P-LIE file {}", path.display()))?;
         return Ok(Loaded { octree, plie, build_seconds: None, load_seconds: Some(t.elapsed().as_secs_f64()) });
     }
-    let octree = Octree::build(scene, params.octree());
+    let octree = Octree::build(scene, params.octree())?;
     let t = Instant::now();
     let limits =
         plie::construct::Limits { list_bytes: Some(crate::budget::list_bytes(crate::budget::default_bytes(), scene)) };

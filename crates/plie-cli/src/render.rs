@@ -124,7 +124,7 @@ pub fn run(a: &Args) -> Result<()> {
         let mode = a.visibility.unwrap_or_else(|| best_mode(&got.plie.params));
         (mode, got.octree, Some(got.plie), got.build_seconds, got.load_seconds)
     } else {
-        (asked, Octree::build(&scene, params.octree()), None, None, None)
+        (asked, Octree::build(&scene, params.octree())?, None, None, None)
     };
     let octree_seconds = t.elapsed().as_secs_f64() - plie_seconds.unwrap_or(0.0);
     let vis = visibility::for_mode(mode, &scene, &bvh, &octree, plie.as_ref())?;

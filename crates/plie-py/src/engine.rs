@@ -9,15 +9,12 @@ use std::time::Instant;
 
 use glam::Vec3;
 use plie::construct::refine::{MaxBlockers, RefineParams};
-use plie::io::plie_file;
-use plie::lie::{Plie, PlieParams};
 use plie::octree::{Octree, OctreeParams};
-use plie::render::path::{Nee, PathSettings};
-use plie::render::{NoProgress, RenderSettings};
 pub use plie::scene::CameraPath;
 use plie::visibility::bvh::Bvh;
-use plie::visibility::{self, Mode, QueryCtx, QueryStats, ShadowRay};
+use plie::visibility::{self, QueryCtx, QueryStats, ShadowRay};
 pub use plie::Camera;
+use plie::{Environment, Integrator, Mode, Nee, PathSettings, PlieParams, RenderSettings, Renderer};
 use plie::{LightId, Scene, TriId};
 use rayon::prelude::*;
 
@@ -28,12 +25,12 @@ fn invalid(m: String) -> Error {
     Error::InvalidParameter(m)
 }
 
-/// A loaded scene with what every render of it shares, built on first use: the BVH and the
-/// fingerprint that ties environments to it.
+/// A loaded scene with what renders and queries without an environment share, built on first use:
+/// the scene BVH and the octree (the CLI's default parameters).
 pub struct LoadedScene {
     pub scene: Scene,
     bvh: OnceLock<Bvh>,
-    fingerprint: OnceLock<u64>,
+    octree: OnceLock<Octree>,
 }
 
 impl LoadedScene {
@@ -51,15 +48,20 @@ impl LoadedScene {
                 plie::io::load_scene_with(path, plie::io::LoadOptions { allow_outside_paths })?
             }
         };
-        Ok(LoadedScene { scene, bvh: OnceLock::new(), fingerprint: OnceLock::new() })
+        Ok(LoadedScene { scene, bvh: OnceLock::new(), octree: OnceLock::new() })
     }
 
     pub fn bvh(&self) -> &Bvh {
         self.bvh.get_or_init(|| Bvh::build(&self.scene))
     }
 
-    fn fingerprint(&self) -> u64 {
-        *self.fingerprint.get_or_init(|| plie_file::scene_fingerprint(&self.scene))
+    /// The octree with the CLI's default parameters (for mode `octree` without an environment).
+    fn octree(&self) -> Result<&Octree> {
+        if let Some(o) = self.octree.get() {
+            return Ok(o);
+        }
+        let o = Octree::build(&self.scene, BuildOptions::default().params(false)?.octree())?;
+        Ok(self.octree.get_or_init(|| o))
     }
 }
 
@@ -148,11 +150,9 @@ impl BuildOptions {
     }
 }
 
-/// An octree and its P-LIE, for one scene.
+/// An environment (octree + P-LIE, [`plie::Environment`]) with the figures of its build or load.
 pub struct Env {
-    pub octree: Octree,
-    pub plie: Plie,
-    scene_fingerprint: u64,
+    pub env: Environment,
     /// Construction figures as JSON, when built here.
     pub stats_json: Option<String>,
     /// Seconds building or loading.
@@ -163,68 +163,38 @@ impl Env {
     /// Builds the octree and the P-LIE (refined if the parameters ask).
     pub fn build(scene: &LoadedScene, params: PlieParams) -> Result<Env> {
         let t = Instant::now();
-        let octree = Octree::build(&scene.scene, params.octree());
-        let built = plie::construct::build_refined(&scene.scene, octree, params, &NoProgress);
-        let stats_json = serde_json::to_string(&built.stats).ok();
-        Ok(Env {
-            octree: built.octree,
-            plie: built.plie,
-            scene_fingerprint: scene.fingerprint(),
-            stats_json,
-            seconds: t.elapsed().as_secs_f64(),
-        })
+        let (env, stats) = Environment::build(&scene.scene, &params)?;
+        let stats_json = serde_json::to_string(&stats).ok();
+        Ok(Env { env, stats_json, seconds: t.elapsed().as_secs_f64() })
     }
 
     /// Saves it as a `.plie` file (atomically); returns the bytes written.
     pub fn save(&self, scene: &LoadedScene, path: &Path) -> Result<u64> {
-        self.check_scene(scene)?;
-        plie_file::save_plie(path, &scene.scene, &self.octree, &self.plie)
+        self.env.save(path, &scene.scene)
     }
 
     /// Loads a `.plie` file built for `scene`.
-    pub fn load(scene: &LoadedScene, path: &Path, expect: Option<PlieParams>) -> Result<Env> {
+    pub fn load(scene: &LoadedScene, path: &Path) -> Result<Env> {
         let t = Instant::now();
-        let (octree, plie) = plie_file::load_plie(path, &scene.scene, expect)?;
-        Ok(Env {
-            octree,
-            plie,
-            scene_fingerprint: scene.fingerprint(),
-            stats_json: None,
-            seconds: t.elapsed().as_secs_f64(),
-        })
+        let env = Environment::load(path, &scene.scene, None)?;
+        Ok(Env { env, stats_json: None, seconds: t.elapsed().as_secs_f64() })
     }
 
     /// Loads a `.plie` file's bytes (e.g. from a distributed object store) built for `scene`.
-    pub fn from_bytes(scene: &LoadedScene, bytes: &[u8], expect: Option<PlieParams>) -> Result<Env> {
+    pub fn from_bytes(scene: &LoadedScene, bytes: &[u8]) -> Result<Env> {
         let t = Instant::now();
-        let (octree, plie) = plie_file::load_plie_bytes(bytes, "<.plie bytes>", &scene.scene, expect)?;
-        Ok(Env {
-            octree,
-            plie,
-            scene_fingerprint: scene.fingerprint(),
-            stats_json: None,
-            seconds: t.elapsed().as_secs_f64(),
-        })
-    }
-
-    /// An error unless this environment was built for `scene`.
-    pub fn check_scene(&self, scene: &LoadedScene) -> Result<()> {
-        if self.scene_fingerprint != scene.fingerprint() {
-            return Err(invalid(format!("the environment was built for another scene, not '{}'", scene.scene.name)));
-        }
-        Ok(())
+        let env = Environment::load_bytes(bytes, "<.plie bytes>", &scene.scene, None)?;
+        Ok(Env { env, stats_json: None, seconds: t.elapsed().as_secs_f64() })
     }
 
     /// The fastest mode it supports (as `plie render --plie` without `--visibility`).
     pub fn best_mode(&self) -> Mode {
-        let p = &self.plie.params;
-        if p.grids {
-            Mode::Grid
-        } else if p.regions {
-            Mode::Penumbra
-        } else {
-            Mode::Lie
-        }
+        self.env.best_mode()
+    }
+
+    /// Octree leaves.
+    pub fn leaves(&self) -> usize {
+        self.env.octree().leaf_count()
     }
 }
 
@@ -260,14 +230,6 @@ pub struct Image {
 /// Parses a visibility mode name.
 pub fn mode(name: &str) -> Result<Mode> {
     name.parse::<Mode>().map_err(|e| invalid(format!("visibility: {e}")))
-}
-
-/// The environment a render uses: the one given, one built with the CLI's default parameters when
-/// the mode needs a P-LIE, or none.
-enum EnvUse<'a> {
-    Given(&'a Env),
-    Built(Box<Env>),
-    Octree(Octree),
 }
 
 /// Renders as `plie render` does with the same options: the same image, bit for bit.
@@ -318,65 +280,35 @@ pub fn render(
     settings.validate()?;
     let camera = camera.unwrap_or_else(|| scene.scene.camera_or_default());
     camera.validate()?;
-    let asked = visibility.map(mode).transpose()?;
-    if let Some(e) = env {
-        e.check_scene(scene)?;
-    }
-    let m = match (asked, env) {
+    let m = match (visibility.map(mode).transpose()?, env) {
         (Some(m), _) => m,
         (None, Some(e)) => e.best_mode(),
         (None, None) => Mode::Bvh,
     };
-    let defaults = BuildOptions::default();
-    let used = match env {
-        Some(e) => EnvUse::Given(e),
-        None if m.needs_plie() => EnvUse::Built(Box::new(Env::build(scene, defaults.params(m == Mode::Grid)?)?)),
-        None => EnvUse::Octree(Octree::build(&scene.scene, defaults.params(false)?.octree())),
+    let integrator = match path {
+        None => Integrator::Direct,
+        Some(p) => Integrator::Path(p),
     };
-    let (octree, plie) = match &used {
-        EnvUse::Given(e) => (&e.octree, Some(&e.plie)),
-        EnvUse::Built(e) => (&e.octree, Some(&e.plie)),
-        EnvUse::Octree(o) => (o, None),
-    };
-    let bvh = scene.bvh();
-    let vis = visibility::for_mode(m, &scene.scene, bvh, octree, plie)?;
-    let run = || -> Result<(Vec<Vec3>, QueryStats)> {
-        match &path {
-            None => {
-                let out = plie::render::render(
-                    &scene.scene,
-                    &camera,
-                    &settings,
-                    bvh,
-                    Some(octree),
-                    vis.as_ref(),
-                    &NoProgress,
-                )?;
-                Ok((out.pixels, out.stats))
-            }
-            Some(p) => {
-                let leaves = m.needs_plie().then_some(octree);
-                let out = plie::render::path::render_path(
-                    &scene.scene,
-                    &camera,
-                    &settings,
-                    p,
-                    bvh,
-                    leaves,
-                    vis.as_ref(),
-                    &NoProgress,
-                )?;
-                Ok((out.pixels, out.stats))
-            }
-        }
-    };
+    let renderer = Renderer::new().settings(settings).camera(camera).integrator(integrator);
     let t = Instant::now();
-    let (pixels, stats) = with_threads(o.threads, run)?;
+    let img = with_threads(o.threads, || match env {
+        Some(e) => renderer.render(&scene.scene, m, Some(&e.env)),
+        // A P-LIE mode without an environment builds one with the CLI's defaults, as `plie render`.
+        None if m.needs_plie() => {
+            let built = Env::build(scene, BuildOptions::default().params(m == Mode::Grid)?)?;
+            renderer.render(&scene.scene, m, Some(&built.env))
+        }
+        None => {
+            let bvh = scene.bvh();
+            let vis = visibility::for_mode(m, &scene.scene, bvh, scene.octree()?, None)?;
+            renderer.render_with(&scene.scene, bvh, None, vis.as_ref())
+        }
+    })?;
     Ok(Image {
-        width: settings.width,
-        height: settings.height,
-        pixels,
-        stats,
+        width: img.width,
+        height: img.height,
+        pixels: img.pixels,
+        stats: img.stats,
         mode: m,
         seconds: t.elapsed().as_secs_f64(),
     })
@@ -431,23 +363,18 @@ pub fn occluded(
         let v = |a: [f64; 3]| Vec3::new(a[0] as f32, a[1] as f32, a[2] as f32);
         rays.push(ShadowRay::new(v(seg.x), v(seg.y), LightId(seg.light as u32), tri, None));
     }
-    if let Some(e) = env {
-        e.check_scene(scene)?;
-    }
     let m = match (visibility.map(mode).transpose()?, env) {
         (Some(m), _) => m,
         (None, Some(e)) => e.best_mode(),
         (None, None) => Mode::Bvh,
     };
-    let octree_only;
-    let (octree, plie) = match env {
-        Some(e) => (&e.octree, Some(&e.plie)),
-        None => {
-            octree_only = Octree::build(s, BuildOptions::default().params(false)?.octree());
-            (&octree_only, None)
+    let vis = match env {
+        Some(e) => e.env.visibility(m, s)?,
+        None if m.needs_plie() => {
+            return Err(invalid(format!("mode {m} answers from a P-LIE: build or load an Environment and pass it")))
         }
+        None => visibility::for_mode(m, s, scene.bvh(), scene.octree()?, None)?,
     };
-    let vis = visibility::for_mode(m, s, scene.bvh(), octree, plie)?;
     let n = s.triangles.len();
     Ok(rays.par_iter().map_init(|| QueryCtx::new(n), |ctx, r| vis.occluded(r, ctx)).collect())
 }

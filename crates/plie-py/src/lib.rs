@@ -238,7 +238,7 @@ impl Environment {
     #[staticmethod]
     fn load(py: Python<'_>, path: PathBuf, scene: &Scene) -> PyResult<Environment> {
         let s = scene.inner.clone();
-        let env = py.detach(|| Env::load(&s, &path, None)).map_err(py_err)?;
+        let env = py.detach(|| Env::load(&s, &path)).map_err(py_err)?;
         Ok(Environment { inner: Arc::new(env), scene: s })
     }
 
@@ -248,7 +248,7 @@ impl Environment {
     fn from_bytes(py: Python<'_>, data: &Bound<'_, PyBytes>, scene: &Scene) -> PyResult<Environment> {
         let s = scene.inner.clone();
         let bytes = data.as_bytes();
-        let env = py.detach(|| Env::from_bytes(&s, bytes, None)).map_err(py_err)?;
+        let env = py.detach(|| Env::from_bytes(&s, bytes)).map_err(py_err)?;
         Ok(Environment { inner: Arc::new(env), scene: s })
     }
 
@@ -279,11 +279,11 @@ impl Environment {
     /// Octree leaves.
     #[getter]
     fn leaves(&self) -> usize {
-        self.inner.octree.leaf_count()
+        self.inner.leaves()
     }
 
     fn __repr__(&self) -> String {
-        format!("<plie.Environment of '{}': {} leaves>", self.scene.scene.name, self.inner.octree.leaf_count())
+        format!("<plie.Environment of '{}': {} leaves>", self.scene.scene.name, self.inner.leaves())
     }
 }
 

@@ -30,7 +30,7 @@ pub struct Report {
 /// Rebuilds the P-LIE of `scene` with `plie`'s parameters and compares it table by table. Returns
 /// the first difference as an error message.
 pub fn verify_full(scene: &Scene, plie: &Plie) -> Result<Report, String> {
-    let octree = Octree::build(scene, plie.params.octree());
+    let octree = Octree::build(scene, plie.params.octree()).map_err(|e| e.to_string())?;
     let built = crate::construct::build_refined(scene, octree, plie.params, &NoProgress).plie;
     first_difference(&built, plie)?;
     Ok(Report { records: plie.records.len(), rays: 0 })

@@ -212,7 +212,7 @@ fn fnv(b: &[u8]) -> u64 {
 /// Loads a scene and, when it loads, builds its octree (where coincident triangles once exploded).
 fn load_and_build(path: &Path) {
     if let Ok(scene) = load_scene(path) {
-        let _ = Octree::build(&scene, plie::octree::OctreeParams::default());
+        let _ = Octree::build(&scene, plie::octree::OctreeParams::default()).expect("valid octree parameters");
     }
 }
 
@@ -246,7 +246,7 @@ fn fuzz_glb() {
 fn plie_seed() -> (plie::Scene, Vec<u8>) {
     let scene = plie::scene::builtin::load("cornell-cube-1").unwrap();
     let params = plie::lie::PlieParams { grids: true, ..plie::lie::PlieParams::thesis() };
-    let octree = Octree::build(&scene, params.octree());
+    let octree = Octree::build(&scene, params.octree()).expect("valid octree parameters");
     let built = plie::construct::build_refined(&scene, octree, params, &plie::render::NoProgress);
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("seed.plie");

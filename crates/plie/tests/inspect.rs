@@ -14,7 +14,7 @@ use plie::visibility::BvhVisibility;
 use plie::{LightId, Scene};
 
 fn build(scene: &Scene, params: PlieParams) -> (Octree, Plie, plie::construct::BuildStats) {
-    let octree = Octree::build(scene, params.octree());
+    let octree = Octree::build(scene, params.octree()).expect("valid octree parameters");
     let (plie, stats) = plie::construct::build(scene, &octree, params, &NoProgress);
     (octree, plie, stats)
 }

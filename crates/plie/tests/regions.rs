@@ -37,7 +37,7 @@ fn point_in(t: &Tri2, rng: &mut TestRng) -> DVec2 {
 }
 
 fn build(scene: &Scene, params: PlieParams) -> (Octree, Plie) {
-    let octree = Octree::build(scene, params.octree());
+    let octree = Octree::build(scene, params.octree()).expect("valid octree parameters");
     let (plie, _) = plie::construct::build(scene, &octree, params, &NoProgress);
     (octree, plie)
 }

@@ -14,6 +14,8 @@
 //! Its umbra, computed from a subset of its blockers, is a subset of the true umbra and still answers
 //! "occluded"; its penumbra and its lit cells are unknown, so it stores none.
 
+mod validate;
+
 use serde::{Deserialize, Serialize};
 
 use crate::construct::refine::RefineParams;
@@ -84,6 +86,13 @@ impl PlieParams {
     /// command-line tool builds unless told otherwise.
     pub fn bounded(self) -> PlieParams {
         PlieParams { blocker_cap: Some(DEFAULT_BLOCKER_CAP), ..self }
+    }
+
+    /// Checks the parameters: the octree's ([`crate::octree::OctreeParams::validate`]) and the
+    /// refinement's, which must agree with the rest (refining by umbra needs regions).
+    pub fn validate(&self) -> crate::Result<()> {
+        self.octree().validate()?;
+        self.refine.validate(self.regions)
     }
 
     /// The octree part of the parameters.

@@ -601,7 +601,7 @@ mod tests {
     fn chunk_boxes_cover_their_lists() {
         let scene = crate::scene::builtin::load("huis-a").unwrap();
         let params = PlieParams { grids: true, ..PlieParams::thesis() };
-        let octree = Octree::build(&scene, params.octree());
+        let octree = Octree::build(&scene, params.octree()).expect("valid octree parameters");
         let (plie, _) = build(&scene, &octree, params, &NoProgress);
         let bvh = crate::visibility::bvh::Bvh::build(&scene);
         let vis = LieVisibility::new(&scene, &bvh, &octree, &plie, Mode::Grid);

@@ -99,7 +99,7 @@ impl Built {
     pub fn refined(scene: &Scene, params: plie::lie::PlieParams) -> Built {
         let params = plie::lie::PlieParams { grids: true, ..params };
         let bvh = plie::visibility::bvh::Bvh::build(scene);
-        let octree = plie::octree::Octree::build(scene, params.octree());
+        let octree = plie::octree::Octree::build(scene, params.octree()).expect("valid octree parameters");
         let b = plie::construct::build_refined(scene, octree, params, &plie::render::NoProgress);
         Built { bvh, octree: b.octree, plie: b.plie }
     }
@@ -107,7 +107,7 @@ impl Built {
     pub fn new(scene: &Scene, params: plie::lie::PlieParams) -> Built {
         let params = plie::lie::PlieParams { grids: true, ..params };
         let bvh = plie::visibility::bvh::Bvh::build(scene);
-        let octree = plie::octree::Octree::build(scene, params.octree());
+        let octree = plie::octree::Octree::build(scene, params.octree()).expect("valid octree parameters");
         let (plie, _) = plie::construct::build(scene, &octree, params, &plie::render::NoProgress);
         Built { bvh, octree, plie }
     }
