@@ -98,7 +98,7 @@ def test_shadow_queries(scene):
         plie.occluded(scene, (np.nan, 0, 0), (1, 1, 1), 0)
     with pytest.raises(ValueError, match="x has 2 points, y has 1"):
         plie.occluded_many(scene, np.zeros((2, 3)), np.zeros((1, 3)), 0)
-    with pytest.raises(plie.PlieError, match="needs a P-LIE"):
+    with pytest.raises(plie.PlieError, match="answers from a P-LIE"):
         plie.occluded(scene, (0, 0, 0), (1, 1, 1), 0, visibility="grid")
 
 
