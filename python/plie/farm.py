@@ -59,25 +59,29 @@ def chunks(frames: Sequence[int], size: int) -> List[List[int]]:
 def _environment(scene_spec: str, allow_outside_paths: bool, env_ref: List[Any], cache: bool):
     """The scene and environment in a worker: from the worker's cache, else fetched from the object
     store (`env_ref == [ObjectRef]`) or read from a file (`env_ref == ["file", path]`, to compare).
-    Also returns where it came from and the seconds spent: fetching the bytes (or reading the file)
-    plus decoding them into the environment (the scene's load not counted)."""
+    Also returns where it came from and the seconds spent fetching the bytes (or reading the file)
+    and decoding them into the environment (checks and the octree's rebuild; the scene's load is not
+    counted)."""
     import ray
 
     key = (scene_spec, env_ref[1] if isinstance(env_ref[0], str) else env_ref[0].hex())
     if cache and key in _CACHE:
-        return _CACHE[key] + ("cache", 0.0)
+        return _CACHE[key] + ("cache", 0.0, 0.0)
     scene = plie.load_scene(scene_spec, allow_outside_paths=allow_outside_paths)
     t = time.perf_counter()
     if isinstance(env_ref[0], str):
-        env = plie.Environment.load(env_ref[1], scene)
+        with open(env_ref[1], "rb") as f:
+            data = f.read()
         source = "file"
     else:
-        env = plie.Environment.from_bytes(ray.get(env_ref[0]), scene)
+        data = ray.get(env_ref[0])
         source = "object store"
-    seconds = time.perf_counter() - t
+    fetched = time.perf_counter()
+    env = plie.Environment.from_bytes(data, scene)
+    decoded = time.perf_counter()
     if cache:
         _CACHE[key] = (scene, env)
-    return scene, env, source, seconds
+    return scene, env, source, fetched - t, decoded - fetched
 
 
 def render_frames(
@@ -95,14 +99,15 @@ def render_frames(
     `["file", path]`."""
     if task_hook is not None:
         task_hook(frames)
-    scene, env, source, env_seconds = _environment(scene_spec, allow_outside_paths, env_ref, cache)
+    scene, env, source, fetch_seconds, decode_seconds = _environment(scene_spec, allow_outside_paths, env_ref, cache)
     path = plie.CameraPath.from_json(path_json)
     t = time.perf_counter()
     images = [(f, plie.render(scene, camera=path.camera(f), env=env, **options)) for f in frames]
     return {
         "images": images,
         "env_source": source,
-        "env_seconds": env_seconds,
+        "fetch_seconds": fetch_seconds,
+        "decode_seconds": decode_seconds,
         "render_seconds": time.perf_counter() - t,
         "pid": os.getpid(),
         "frames": frames,
@@ -193,7 +198,7 @@ def render_walkthrough(
             plie.save_image(file, image, exposure=exposure)
             done += 1
             progress(f"frame {f} ({done} of {len(todo)}) wrote {file}")
-        tasks.append({k: r[k] for k in ("frames", "env_source", "env_seconds", "render_seconds", "pid")})
+        tasks.append({k: r[k] for k in ("frames", "env_source", "fetch_seconds", "decode_seconds", "render_seconds", "pid")})
     seconds = time.perf_counter() - t1
     return {
         "frames": done,
