@@ -1,5 +1,5 @@
 //! `plie render --camera-path PATH.json --frames A..B -o out/frame_####.png`: a walkthrough, one
-//! image per frame of a keyframed camera path ([`plie::scene::CameraPath`]), all rendered from the
+//! image per frame of a keyframed camera path ([`plie::io::camera_path::CameraPath`]), all rendered from the
 //! scene and the P-LIE loaded once (a P-LIE serves every camera, SPEC §4). Each frame is written
 //! atomically; `--resume` skips frames whose file exists. This is what one task of a Slurm job array
 //! or another render-farm manager runs.
@@ -10,7 +10,7 @@ use std::time::Instant;
 
 use anyhow::{bail, Context, Result};
 use glam::Vec3;
-use plie::scene::CameraPath;
+use plie::io::camera_path::CameraPath;
 use plie::Camera;
 use serde_json::json;
 

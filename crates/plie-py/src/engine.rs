@@ -9,8 +9,8 @@ use std::time::Instant;
 
 use glam::Vec3;
 use plie::construct::refine::{MaxBlockers, RefineParams};
+pub use plie::io::camera_path::CameraPath;
 use plie::octree::{Octree, OctreeParams};
-pub use plie::scene::CameraPath;
 use plie::visibility::bvh::Bvh;
 use plie::visibility::{self, QueryCtx, QueryStats, ShadowRay};
 pub use plie::Camera;
@@ -379,7 +379,7 @@ pub fn occluded(
     Ok(rays.par_iter().map_init(|| QueryCtx::new(n), |ctx, r| vis.occluded(r, ctx)).collect())
 }
 
-/// A camera path ([`plie::scene::CameraPath`]) from JSON text or a file.
+/// A camera path ([`plie::io::camera_path::CameraPath`]) from JSON text or a file.
 pub fn camera_path(text: Option<&str>, file: Option<&Path>) -> Result<CameraPath> {
     match (text, file) {
         (Some(t), _) => CameraPath::from_json(t),

@@ -4,7 +4,6 @@
 
 pub mod builtin;
 pub mod camera;
-pub mod camera_path;
 pub mod ids;
 pub mod light;
 pub mod material;
@@ -12,7 +11,6 @@ pub mod material;
 mod scene;
 
 pub use camera::Camera;
-pub use camera_path::CameraPath;
 pub use ids::{LightId, MaterialId, TriId};
 pub use light::Light;
 pub use material::Material;

@@ -81,7 +81,7 @@ impl CameraPath {
 
     /// Reads a camera path file ([`CameraPath::from_json`]); errors name the file.
     pub fn load(file: &std::path::Path) -> Result<CameraPath> {
-        let bytes = crate::io::input::read_bounded(file, 1 << 26)?;
+        let bytes = super::input::read_bounded(file, 1 << 26)?;
         let bad = |message: String| Error::Parse { path: file.to_path_buf(), line: None, message };
         let text = String::from_utf8(bytes).map_err(|_| bad("camera path: not UTF-8 text".into()))?;
         CameraPath::from_json(&text).map_err(|e| match e {
