@@ -319,9 +319,9 @@ fn print_answers(s: &QueryStats) {
 
 /// The fastest mode a P-LIE supports: `grid` with face grids, else `penumbra` with regions, else `lie`.
 fn best_mode(params: &plie::lie::PlieParams) -> Mode {
-    if params.grids {
+    if params.has_grids() {
         Mode::Grid
-    } else if params.regions {
+    } else if params.has_regions() {
         Mode::Penumbra
     } else {
         Mode::Lie

@@ -164,9 +164,9 @@ impl Environment {
     /// regions, else `lie`.
     pub fn best_mode(&self) -> Mode {
         let p = &self.plie.params;
-        if p.grids {
+        if p.has_grids() {
             Mode::Grid
-        } else if p.regions {
+        } else if p.has_regions() {
             Mode::Penumbra
         } else {
             Mode::Lie

@@ -61,7 +61,7 @@ pub mod scene;
 pub use construct::BuildStats;
 pub use environment::{BuildOptions, Environment, Report};
 pub use error::{Error, PlieFileError, Result};
-pub use lie::PlieParams;
+pub use lie::{Grids, PlieParams, Propagation, Regions};
 pub use render::path::{Nee, PathSettings};
 pub use render::{Image, Integrator, Progress, RenderSettings, Renderer};
 pub use scene::{Camera, Light, LightId, Material, MaterialId, Scene, SceneBuilder, TriId};

@@ -78,8 +78,8 @@ pub fn verify_sample(
     let mut rng = SplitMix(seed ^ 0x0005_eed0_f91e);
     let modes: Vec<Mode> = [Mode::Lie, Mode::Umbra, Mode::Penumbra, Mode::Grid]
         .into_iter()
-        .filter(|m| !m.needs_regions() || plie.params.regions)
-        .filter(|m| *m != Mode::Grid || plie.params.grids)
+        .filter(|m| !m.needs_regions() || plie.params.has_regions())
+        .filter(|m| *m != Mode::Grid || plie.params.has_grids())
         .collect();
     let bvh = crate::visibility::bvh::Bvh::build(scene);
     let lie: Vec<LieVisibility> = modes.iter().map(|&m| LieVisibility::new(scene, &bvh, octree, plie, m)).collect();

@@ -8,7 +8,7 @@
 use glam::{Vec2, Vec3};
 use plie::construct::data_objects::{face_sees_light, thesis_face_sees_light};
 use plie::geometry::RayTest;
-use plie::lie::PlieParams;
+use plie::lie::{PlieParams, Regions};
 use plie::octree::{Dir, LeafId, Octree};
 use plie::render::NoProgress;
 use plie::visibility::Mode;
@@ -104,7 +104,7 @@ fn blockers_contain_every_triangle_between_face_and_light() {
 fn faces_without_a_record_receive_no_light() {
     // Without regions, so that no record is removed for being dark (tests/regions.rs checks those).
     let scene = room();
-    let params = PlieParams { max_triangles: 8, regions: false, ..PlieParams::thesis() };
+    let params = PlieParams { max_triangles: 8, regions: Regions::Skip, ..PlieParams::thesis() };
     let octree = Octree::build(&scene, params.octree()).expect("valid octree parameters");
     let (plie, _) = plie::construct::build(&scene, &octree, params, &NoProgress);
     let light = &scene.lights[0];

@@ -9,7 +9,7 @@ use plie::render::path::{render_path, Nee, PathSettings};
 use plie::render::{render, NoProgress, RenderSettings};
 use plie::visibility::bvh::Bvh;
 use plie::visibility::for_mode;
-use plie::{Environment, Error, Integrator, Mode, PlieFileError, PlieParams, Renderer, Shadows};
+use plie::{Environment, Error, Integrator, Mode, PlieFileError, PlieParams, Propagation, Regions, Renderer, Shadows};
 
 fn bits(p: &[glam::Vec3]) -> Vec<[u32; 3]> {
     p.iter().map(|v| v.to_array().map(f32::to_bits)).collect()
@@ -99,7 +99,7 @@ fn bad_parameters_are_errors_not_panics() {
     for params in [
         PlieParams { max_depth: 0, ..PlieParams::default() },
         PlieParams { max_triangles: 0, ..PlieParams::default() },
-        PlieParams { regions: false, refine: RefineParams::thesis_umbra(), ..PlieParams::default() },
+        PlieParams { regions: Regions::Skip, refine: RefineParams::thesis_umbra(), ..PlieParams::default() },
     ] {
         assert!(matches!(Environment::build(&scene, &params), Err(Error::InvalidParameter(_))), "{params:?}");
     }
@@ -113,7 +113,7 @@ fn modes_are_refused_where_they_cannot_answer() {
     let shadows = Shadows::new(&scene);
     assert!(shadows.visibility(Mode::Grid).is_err(), "the P-LIE modes need an environment");
     assert!(Renderer::new().size(4, 4).render(&scene, Mode::Lie, None).is_err());
-    let params = PlieParams { regions: false, propagation: false, ..PlieParams::default() };
+    let params = PlieParams { regions: Regions::Skip, propagation: Propagation::Off, ..PlieParams::default() };
     let (env, _) = Environment::build(&scene, &params).unwrap();
     assert!(env.visibility(Mode::Umbra, &scene).is_err(), "umbra needs regions");
     assert!(env.visibility(Mode::Lie, &scene).is_ok());

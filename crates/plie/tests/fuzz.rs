@@ -245,7 +245,7 @@ fn fuzz_glb() {
 /// A `.plie` file of cornell-cube-1 (built here: the format's version may change).
 fn plie_seed() -> (plie::Scene, Vec<u8>) {
     let scene = plie::scene::builtin::load("cornell-cube-1").unwrap();
-    let params = plie::lie::PlieParams { grids: true, ..plie::lie::PlieParams::thesis() };
+    let params = plie::lie::PlieParams { grids: plie::lie::Grids::Build, ..plie::lie::PlieParams::thesis() };
     let octree = Octree::build(&scene, params.octree()).expect("valid octree parameters");
     let built = plie::construct::build_refined(&scene, octree, params, &plie::render::NoProgress);
     let dir = tempfile::tempdir().unwrap();

@@ -14,7 +14,7 @@ mod support;
 
 use glam::{Vec2, Vec3};
 use plie::construct::{build_traced, Built};
-use plie::lie::{Plie, PlieParams};
+use plie::lie::{Plie, PlieParams, Propagation};
 use plie::octree::{Dir, LeafId, Octree};
 use plie::render::{render, NoProgress, RenderSettings};
 use plie::visibility::lie::exit_face;
@@ -111,7 +111,7 @@ fn check_scene(scene: &Scene, max_triangles: usize, samples: usize) -> (usize, u
     let params = PlieParams { max_triangles, ..PlieParams::default() };
     let octree = Octree::build(scene, params.octree()).expect("valid octree parameters");
     let with = build(scene, &octree, params);
-    let without = build(scene, &octree, PlieParams { propagation: false, ..params });
+    let without = build(scene, &octree, PlieParams { propagation: Propagation::Off, ..params });
     assert!(without.propagated.is_empty());
     assert_eq!(with.stats.records_removed_propagation, with.propagated.len());
     check_same_records(scene, &octree, &with, &without.plie);

@@ -11,7 +11,7 @@ mod support;
 use glam::Vec3;
 use plie::construct::refine::{MaxBlockers, RefineParams};
 use plie::construct::{build, build_refined};
-use plie::lie::PlieParams;
+use plie::lie::{Grids, PlieParams, Propagation};
 use plie::octree::Octree;
 use plie::render::{render, NoProgress, RenderSettings};
 use plie::visibility::{Mode, QueryCtx};
@@ -98,7 +98,7 @@ fn refined_p_lies_by_blockers_are_exact() {
 fn reused_records_equal_a_build_from_scratch() {
     for name in ["cornell-cube-1", "cornell-cube-4", "dragon", "huis-c"] {
         let scene = plie::scene::builtin::load(name).unwrap();
-        let params = PlieParams { propagation: false, grids: true, ..refined_params() };
+        let params = PlieParams { propagation: Propagation::Off, grids: Grids::Build, ..refined_params() };
         let octree = Octree::build(&scene, params.octree()).expect("valid octree parameters");
         let refined = build_refined(&scene, octree, params, &NoProgress);
         assert!(refined.stats.refine_rounds > 0, "{name}: nothing split");
@@ -122,7 +122,8 @@ fn refinement_does_not_depend_on_the_thread_count() {
             let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
             pool.install(|| {
                 let octree = Octree::build(&scene, PlieParams::thesis().octree()).expect("valid octree parameters");
-                let b = build_refined(&scene, octree, PlieParams { grids: true, ..refined_params() }, &NoProgress);
+                let b =
+                    build_refined(&scene, octree, PlieParams { grids: Grids::Build, ..refined_params() }, &NoProgress);
                 (b.octree, b.plie, b.propagated)
             })
         };

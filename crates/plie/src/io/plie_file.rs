@@ -177,7 +177,7 @@ fn read_plie(bytes: &[u8], scene: &Scene, expect: Option<PlieParams>) -> Result<
     }
     let invalid = |e: Error| PlieFileError::InvalidParameters(e.to_string());
     body.params.octree().validate().map_err(invalid)?;
-    body.params.refine.validate(body.params.regions).map_err(invalid)?;
+    body.params.refine.validate(body.params.has_regions()).map_err(invalid)?;
     let mut octree = Octree::build_valid(scene, body.params.octree());
     for round in &body.plie.splits {
         octree = octree.split_nodes(scene, round).map_err(|e| PlieFileError::Inconsistent(e.to_string()))?;

@@ -106,7 +106,7 @@ pub(crate) fn make<'a>(
         Mode::Bvh => Box::new(BvhVisibility::new(scene, bvh())),
         Mode::Lie | Mode::Umbra | Mode::Penumbra | Mode::Grid => {
             let plie = plie.ok_or_else(|| crate::Error::InvalidParameter(format!("mode {mode} needs a P-LIE")))?;
-            if mode.needs_regions() && !plie.params.regions {
+            if mode.needs_regions() && !plie.params.has_regions() {
                 return Err(crate::Error::InvalidParameter(format!(
                     "mode {mode} needs umbra and penumbra, but the P-LIE was built without them (--no-regions)"
                 )));
