@@ -14,8 +14,9 @@ use plie::octree::{Octree, OctreeParams};
 use plie::visibility::bvh::Bvh;
 use plie::visibility::{self, QueryCtx, QueryStats, ShadowRay};
 pub use plie::Camera;
-use plie::{Environment, Integrator, Mode, Nee, PathSettings, PlieParams, RenderSettings, Renderer};
+use plie::{Environment, Grids, Integrator, Mode, Nee, PathSettings, PlieParams, Propagation, Regions};
 use plie::{LightId, Scene, TriId};
+use plie::{RenderSettings, Renderer};
 use rayon::prelude::*;
 
 pub use plie::Error;
@@ -133,9 +134,9 @@ impl BuildOptions {
         let p = PlieParams {
             max_triangles: self.max_triangles,
             max_depth: self.max_depth,
-            grids: want_grids && !self.no_grids,
-            regions: !self.no_regions,
-            propagation: !self.no_propagation,
+            grids: if want_grids && !self.no_grids { Grids::Build } else { Grids::Skip },
+            regions: if self.no_regions { Regions::Skip } else { Regions::Compute },
+            propagation: if self.no_propagation { Propagation::Off } else { Propagation::On },
             refine: RefineParams {
                 umbra_full,
                 umbra_free,
@@ -144,8 +145,7 @@ impl BuildOptions {
             },
             blocker_cap: self.blocker_cap,
         };
-        p.octree().validate()?;
-        p.refine.validate(p.regions)?;
+        p.validate()?;
         Ok(p)
     }
 }
