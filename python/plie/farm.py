@@ -114,6 +114,26 @@ def render_frames(
     }
 
 
+def check_inputs(camera_path: str, output: str, frames: Optional[Tuple[int, int]]) -> Tuple[str, Tuple[int, int]]:
+    """Checks a walkthrough's inputs before any work (as `plie render --camera-path` does): the
+    output pattern and folder, the camera path, the frame range and every frame's camera. Returns the
+    camera path's JSON and the frames (first, last), both included."""
+    frame_file(output, 0)
+    out_dir = os.path.dirname(output) or "."
+    if not os.path.isdir(out_dir):
+        raise FileNotFoundError(f"{output}: the output folder {out_dir} does not exist")
+    with open(camera_path, encoding="utf-8") as f:
+        path_json = f.read()
+    path = plie.CameraPath.from_json(path_json)
+    first, last = path.frames
+    a, b = frames if frames is not None else (first, last)
+    if a < first or b > last:
+        raise ValueError(f"--frames {a}..{b} is outside the camera path's frames {first}..{last} ({camera_path})")
+    for f in range(a, b + 1):
+        path.camera(f)
+    return path_json, (a, b)
+
+
 def render_walkthrough(
     scene: str,
     camera_path: str,
@@ -142,19 +162,7 @@ def render_walkthrough(
 
     if not ray.is_initialized():
         raise RuntimeError("call ray.init() (or ray.init(address=...)) first")
-    frame_file(output, 0)  # the pattern is checked before any work
-    out_dir = os.path.dirname(output) or "."
-    if not os.path.isdir(out_dir):
-        raise FileNotFoundError(f"{output}: the output folder {out_dir} does not exist")
-    with open(camera_path, encoding="utf-8") as f:
-        path_json = f.read()
-    path = plie.CameraPath.from_json(path_json)
-    first, last = path.frames
-    a, b = frames if frames is not None else (first, last)
-    if a < first or b > last:
-        raise ValueError(f"--frames {a}..{b} is outside the camera path's frames {first}..{last} ({camera_path})")
-    for f in range(a, b + 1):
-        path.camera(f)  # every camera is checked before any work
+    path_json, (a, b) = check_inputs(camera_path, output, frames)
     if os.path.exists(scene):
         scene = os.path.abspath(scene)
     t0 = time.perf_counter()
@@ -249,6 +257,7 @@ def main(argv: Optional[Iterable[str]] = None) -> int:
         return 1
     try:
         frames = parse_frames(a.frames) if a.frames else None
+        check_inputs(a.camera_path, a.output, frames)  # before starting or joining a cluster
         if a.address:
             ray.init(address=a.address)
         else:

@@ -111,3 +111,17 @@ def test_bad_walkthroughs_raise(cluster, walk, tmp_path):
         plie.farm.render_walkthrough("cornell-cube-2", str(path), str(tmp_path / "f#.png"), frames=(2, 9))
     with pytest.raises(plie.PlieError, match="another scene"):
         plie.farm.render_walkthrough("cornell-cube-1", str(path), str(tmp_path / "f#.png"), plie_file=str(env))
+
+
+def test_the_command_line_rejects_bad_input_before_starting_ray(tmp_path, capsys):
+    path = tmp_path / "walk.json"
+    path.write_text(PATH)
+    # No cluster is started for these (main() would call ray.init only after the checks).
+    assert plie.farm.main(["--scene", "cornell-cube-2", "--camera-path", str(path), "-o", str(tmp_path / "f.png")]) == 1
+    assert "one run of #" in capsys.readouterr().err
+    assert plie.farm.main(["--scene", "cornell-cube-2", "--camera-path", str(path), "--frames", "1..9",
+                           "-o", str(tmp_path / "f#.png")]) == 1
+    assert "outside the camera path's frames 0..3" in capsys.readouterr().err
+    assert plie.farm.main(["--scene", "cornell-cube-2", "--camera-path", str(tmp_path / "none.json"),
+                           "-o", str(tmp_path / "f#.png")]) == 1
+    assert "none.json" in capsys.readouterr().err
