@@ -77,7 +77,7 @@ impl Plie {
                 return Err(format!("record {i}: region triangles out of bounds"));
             }
         }
-        let units = crate::construct::regions::UNITS as i32;
+        let units = super::frame::UNITS as i32;
         if p.region_tris.iter().flatten().flatten().any(|&c| c.abs() > 4 * units) {
             return Err("region triangle out of range".into());
         }
