@@ -20,8 +20,8 @@ use plie::scene::builtin;
 use plie::visibility::bvh::Bvh;
 use plie::visibility::{self, Mode};
 use plie::{Camera, Scene};
-use serde::Serialize;
 
+use crate::bench_data::{median, BreakEven, BuildResult, Plan, Results, SceneResult, Shading};
 use crate::progress::Bar;
 use crate::scene_arg::SceneArgs;
 
@@ -72,125 +72,19 @@ pub struct Args {
     path_modes: Vec<Mode>,
 }
 
-/// What is measured: scenes, image settings, runs.
-pub struct Plan {
-    pub scenes: Vec<String>,
-    /// Image sizes (width = height), 1 eye ray per pixel.
-    pub sizes: Vec<u32>,
-    /// Shadow rays per light.
-    pub shadow_rays: Vec<u32>,
-    pub runs: usize,
-    pub modes: Vec<Mode>,
-    /// The modes also measured on the refined P-LIE (those that use a P-LIE).
-    pub refined_modes: Vec<Mode>,
-}
-
-impl Plan {
-    fn new(a: &Args) -> Result<Plan> {
-        let runs = a.runs.unwrap_or(if a.quick { 1 } else { 5 });
-        anyhow::ensure!(runs >= 1, "--runs must be at least 1");
-        let scenes = match (a.scenes.is_empty(), a.quick) {
-            (false, _) => a.scenes.clone(),
-            (true, true) => vec!["cornell-cube-1".into(), "cornell-cube-3".into()],
-            (true, false) => builtin::NAMES.iter().chain(&builtin::STRESS).map(|s| s.to_string()).collect(),
-        };
-        let (sizes, shadow_rays) = if a.quick { (vec![32], vec![4]) } else { (vec![126, 254], vec![4, 9]) };
-        let modes: Vec<Mode> = Mode::EXACT.into_iter().filter(|m| *m != Mode::Brute).collect();
-        let refined_modes = modes.iter().copied().filter(|m| m.needs_plie()).collect();
-        Ok(Plan { scenes, sizes, shadow_rays, runs, modes, refined_modes })
-    }
-
-    /// The setting of the break-even figures: the largest image with the fewest shadow rays (254/4).
-    pub fn break_even_setting(&self) -> (u32, u32) {
-        (*self.sizes.iter().max().expect("a size"), *self.shadow_rays.iter().min().expect("a count"))
-    }
-
-    /// The setting of the single-threaded throughput: the smallest image, fewest shadow rays.
-    pub fn throughput_setting(&self) -> (u32, u32) {
-        (*self.sizes.iter().min().expect("a size"), *self.shadow_rays.iter().min().expect("a count"))
-    }
-
-    fn steps_per_scene(&self) -> u64 {
-        let m = self.modes.len() as u64;
-        let settings = (self.sizes.len() * self.shadow_rays.len()) as u64;
-        1 + m * settings + m + self.refined_modes.len() as u64 * settings
-    }
-}
-
-/// Everything measured; serialised as results.json.
-#[derive(Serialize)]
-pub struct Results {
-    pub command: String,
-    pub date: String,
-    pub cores: usize,
-    pub cpu: Option<String>,
-    pub threads: usize,
-    pub runs: usize,
-    pub quick: bool,
-    pub break_even_setting: (u32, u32),
-    pub throughput_setting: (u32, u32),
-    pub scenes: Vec<SceneResult>,
-}
-
-/// The figures of one scene.
-#[derive(Serialize)]
-pub struct SceneResult {
-    pub name: String,
-    pub triangles: usize,
-    pub lights: usize,
-    pub bvh_seconds: f64,
-    pub octree_seconds: f64,
-    pub builds: Vec<BuildResult>,
-    /// All-threads rows for every setting, then 1-thread rows at the throughput setting.
-    pub shading: Vec<Shading>,
-    pub break_even: Vec<BreakEven>,
-}
-
-/// One P-LIE construction (median seconds of the construction alone, octree excluded).
-#[derive(Serialize)]
-pub struct BuildResult {
-    /// "thesis" (`PlieParams::thesis()`), "grids" (`PlieParams::default()`), "blockers-only" (the
-    /// thesis' parameters without regions), "no-propagation" (the thesis' without propagation),
-    /// "refined" (the thesis' refined by umbra, at most 2 splits: test 2) or "refined-grids" (the
-    /// same with face grids).
-    pub config: &'static str,
-    pub seconds: f64,
-    pub leaves: usize,
-    pub records: usize,
-    pub records_removed_umbra: usize,
-    pub records_removed_propagation: usize,
-    pub blockers_mean: f64,
-    pub blockers_max: u32,
-}
-
-/// The shading pass of one mode at one setting (median seconds).
-#[derive(Serialize)]
-pub struct Shading {
-    pub mode: Mode,
-    /// On the refined P-LIE (and its refined octree): the thesis' "+u" columns.
-    pub refined: bool,
-    pub size: u32,
-    pub shadow_rays: u32,
-    pub threads: usize,
-    pub seconds: f64,
-    pub rays: u64,
-    pub triangle_tests_per_ray: f64,
-    /// Of `triangle_tests_per_ray`, the tests of P-LIE blockers (P-LIE modes; 0 in the others).
-    pub blocker_tests_per_ray: f64,
-    /// Of `triangle_tests_per_ray`, the tests of the ray's own leaf (P-LIE modes; 0 in the others).
-    pub own_leaf_tests_per_ray: f64,
-    pub mrays_per_second: f64,
-    pub mrays_per_second_per_core: f64,
-}
-
-/// Images after which `mode` (build + shading) beats `against` (build + shading); None: never.
-#[derive(Serialize)]
-pub struct BreakEven {
-    pub mode: Mode,
-    /// `mode` on the refined P-LIE, its build cost the refined construction.
-    pub refined: bool,
-    pub against: Mode,
-    pub images: Option<u64>,
+/// The plan `a` asks for.
+fn plan(a: &Args) -> Result<Plan> {
+    let runs = a.runs.unwrap_or(if a.quick { 1 } else { 5 });
+    anyhow::ensure!(runs >= 1, "--runs must be at least 1");
+    let scenes = match (a.scenes.is_empty(), a.quick) {
+        (false, _) => a.scenes.clone(),
+        (true, true) => vec!["cornell-cube-1".into(), "cornell-cube-3".into()],
+        (true, false) => builtin::NAMES.iter().chain(&builtin::STRESS).map(|s| s.to_string()).collect(),
+    };
+    let (sizes, shadow_rays) = if a.quick { (vec![32], vec![4]) } else { (vec![126, 254], vec![4, 9]) };
+    let modes: Vec<Mode> = Mode::EXACT.into_iter().filter(|m| *m != Mode::Brute).collect();
+    let refined_modes = modes.iter().copied().filter(|m| m.needs_plie()).collect();
+    Ok(Plan { scenes, sizes, shadow_rays, runs, modes, refined_modes })
 }
 
 pub fn run(a: &Args) -> Result<()> {
@@ -202,7 +96,7 @@ pub fn run(a: &Args) -> Result<()> {
         anyhow::ensure!(runs >= 1, "--runs must be at least 1");
         return crate::bench_soft::run(&scenes, &a.out, runs, a.quiet);
     }
-    let plan = Plan::new(a)?;
+    let plan = plan(a)?;
     if a.path {
         return run_path(a, plan);
     }
@@ -281,16 +175,6 @@ fn timed<T>(runs: usize, mut f: impl FnMut() -> T) -> (T, f64) {
         times.push(t.elapsed().as_secs_f64());
     }
     (last.expect("at least one run"), median(&mut times))
-}
-
-pub fn median(xs: &mut [f64]) -> f64 {
-    xs.sort_by(f64::total_cmp);
-    let n = xs.len();
-    if n % 2 == 1 {
-        xs[n / 2]
-    } else {
-        0.5 * (xs[n / 2 - 1] + xs[n / 2])
-    }
 }
 
 fn build_plie(

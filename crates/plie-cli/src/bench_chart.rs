@@ -4,8 +4,7 @@
 use anyhow::{anyhow, Result};
 use plotters::prelude::*;
 
-use crate::bench::{Plan, Results};
-use crate::bench_report::seconds;
+use crate::bench_data::{seconds, Plan, Results};
 
 /// The grouped bar chart as SVG text.
 pub fn svg(plan: &Plan, r: &Results) -> Result<String> {

@@ -9,7 +9,7 @@ use std::path::Path;
 use anyhow::{Context, Result};
 use plie::visibility::Mode;
 
-use crate::bench::{Plan, Results, SceneResult};
+use crate::bench_data::{seconds_of, Plan, Results};
 
 /// The thesis' figures (shared/thesis/*.tsv).
 #[derive(Default)]
@@ -229,19 +229,6 @@ fn construction(s: &mut String, r: &Results, th: Option<&Thesis>) {
         total(5)
     );
     s.push('\n');
-}
-
-/// Median shading seconds of `mode` at (size, rays) with `threads` threads, on the unrefined P-LIE.
-pub fn seconds(sc: &SceneResult, mode: Mode, size: u32, rays: u32, threads: usize) -> Option<f64> {
-    seconds_of(sc, mode, false, size, rays, threads)
-}
-
-/// Median shading seconds of `mode` on the refined (`+u`) or unrefined P-LIE.
-pub fn seconds_of(sc: &SceneResult, mode: Mode, refined: bool, size: u32, rays: u32, threads: usize) -> Option<f64> {
-    let row = sc.shading.iter().find(|x| {
-        x.mode == mode && x.refined == refined && x.size == size && x.shadow_rays == rays && x.threads == threads
-    });
-    row.map(|x| x.seconds)
 }
 
 /// A mode's column label: `lie`, or `lie+u` on the refined P-LIE.

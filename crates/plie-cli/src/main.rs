@@ -4,6 +4,7 @@
 
 mod bench;
 mod bench_chart;
+mod bench_data;
 mod bench_path;
 mod bench_report;
 mod bench_soft;
