@@ -21,6 +21,7 @@ mod render_path;
 mod scene_arg;
 mod scenes;
 mod verify;
+mod walkthrough;
 
 use clap::{CommandFactory, FromArgMatches, Parser, Subcommand};
 

@@ -18,6 +18,7 @@ use crate::plie_args::{load_file, load_or_build, PlieArgs};
 use crate::progress::Bar;
 use crate::render_path;
 use crate::scene_arg::{CameraArgs, SceneArgs};
+use crate::walkthrough::{FrameRange, Plan};
 
 /// Options of `plie render`.
 #[derive(clap::Args)]
@@ -26,9 +27,20 @@ pub struct Args {
     scene: SceneArgs,
     #[command(flatten)]
     camera: CameraArgs,
-    /// Output image; the extension picks the format: .png, .exr, .pfm.
+    /// Output image; the extension picks the format: .png, .exr, .pfm. With --camera-path, a pattern
+    /// whose run of # is replaced by the frame number, zero-padded (out/frame_####.png).
     #[arg(short = 'o', long = "output", value_name = "OUT")]
     output: PathBuf,
+    /// Render a walkthrough: one image per frame of this camera path (JSON keyframes, interpolation
+    /// `linear` or `catmull-rom`; see the README), all from one scene and P-LIE.
+    #[arg(long, value_name = "PATH.json", conflicts_with_all = ["eye", "target", "up", "fov", "stats"])]
+    camera_path: Option<PathBuf>,
+    /// With --camera-path: the frames to render, `A..B` (both included) or `N` (default: all).
+    #[arg(long, value_name = "A..B", requires = "camera_path")]
+    frames: Option<FrameRange>,
+    /// With --camera-path: skip frames whose output file exists.
+    #[arg(long, requires = "camera_path")]
+    resume: bool,
     #[command(flatten)]
     image: ImageArgs,
     #[command(flatten)]
@@ -72,8 +84,13 @@ pub struct Args {
 pub fn run(a: &Args, matches: &clap::ArgMatches) -> Result<()> {
     crate::scenes::set_threads(a.threads)?;
     plie::io::ImageFormat::from_path(&a.output)?;
-    let inputs: Vec<&std::path::Path> = a.scene.file().into_iter().chain(a.plie.as_deref()).collect();
-    crate::checks::output_is_not_input(&a.output, &inputs)?;
+    let inputs: Vec<&std::path::Path> =
+        a.scene.file().into_iter().chain(a.plie.as_deref()).chain(a.camera_path.as_deref()).collect();
+    let walk = a.camera_path.as_deref().map(|p| Plan::new(p, a.frames, &a.output, a.resume)).transpose()?;
+    match &walk {
+        Some(w) => crate::checks::output_is_not_input(&w.file(0), &inputs)?,
+        None => crate::checks::output_is_not_input(&a.output, &inputs)?,
+    }
     let mut settings = a.image.settings()?;
     if a.path.integrator == Integrator::Direct {
         settings.eye_rays = a.path.eye_rays(settings.eye_rays)?;
@@ -116,6 +133,26 @@ pub fn run(a: &Args, matches: &clap::ArgMatches) -> Result<()> {
     };
     let octree_seconds = t.elapsed().as_secs_f64() - plie_seconds.unwrap_or(0.0);
     let vis = visibility::for_mode(mode, &scene, &bvh, &octree, plie.as_ref())?;
+    if let Some(walk) = walk {
+        let render_frame = |camera: &plie::Camera| -> Result<Vec<glam::Vec3>> {
+            if a.path.integrator == Integrator::Path {
+                let setup = render_path::Setup {
+                    scene: &scene,
+                    camera,
+                    settings,
+                    bvh: &bvh,
+                    octree: &octree,
+                    vis: vis.as_ref(),
+                    mode,
+                    bar: &bar,
+                };
+                return Ok(render_path::trace(&setup, &a.path)?.pixels);
+            }
+            Ok(render(&scene, camera, &settings, &bvh, Some(&octree), vis.as_ref(), &bar)?.pixels)
+        };
+        let save = |file: &std::path::Path, pixels| render_path::save(file, &settings, a.image.exposure, pixels);
+        return walk.run(a.quiet, a.json, render_frame, save);
+    }
     if a.path.integrator == Integrator::Path {
         let setup = render_path::Setup {
             scene: &scene,

@@ -115,6 +115,13 @@ impl Environment {
         Ok(Environment::from_parts(scene, octree, plie))
     }
 
+    /// [`Environment::load`] from the bytes of a `.plie` file already in memory (e.g. fetched from a
+    /// distributed object store), with the same checks; `origin` names the bytes in errors.
+    pub fn load_bytes(bytes: &[u8], origin: &str, scene: &Scene, expect: Option<&PlieParams>) -> Result<Environment> {
+        let (octree, plie) = plie_file::load_plie_bytes(bytes, origin, scene, expect.copied())?;
+        Ok(Environment::from_parts(scene, octree, plie))
+    }
+
     /// Checks the octree's invariants and the P-LIE's tables against `scene`.
     pub fn validate(&self, scene: &Scene) -> Report {
         let plie = match self.check_scene(scene) {

@@ -13,6 +13,7 @@
 //! what the underlying crates would panic on is checked before they see it.
 
 pub mod atomic;
+pub mod camera_path;
 pub mod gltf;
 pub mod gltf_export;
 pub mod image;

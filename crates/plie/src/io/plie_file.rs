@@ -128,6 +128,17 @@ pub fn load_plie(path: &Path, scene: &Scene, expect: Option<PlieParams>) -> Resu
     read_plie(&bytes, scene, expect).map_err(|problem| Error::PlieFile { path: path.to_path_buf(), problem })
 }
 
+/// [`load_plie`] from the bytes of a `.plie` file already in memory (e.g. fetched from a distributed
+/// object store), with the same checks; `origin` names the bytes in errors.
+pub fn load_plie_bytes(
+    bytes: &[u8],
+    origin: &str,
+    scene: &Scene,
+    expect: Option<PlieParams>,
+) -> Result<(Octree, Plie)> {
+    read_plie(bytes, scene, expect).map_err(|problem| Error::PlieFile { path: origin.into(), problem })
+}
+
 /// [`load_plie`] of the file's bytes.
 fn read_plie(bytes: &[u8], scene: &Scene, expect: Option<PlieParams>) -> Result<(Octree, Plie), PlieFileError> {
     if bytes.len() < 8 || bytes[..8] != MAGIC {
