@@ -9,12 +9,19 @@
 //! `1e-4`, and a clamped inverse still keeps every point at least `PAD` inside a padded box within
 //! `PAD / EPSILON > SEGMENT_T` of the interval; rounding in the slab test is far below `PAD`. Candidates
 //! are then decided by the shared [`blocks`] predicate, so answers equal brute force.
-
-use std::time::Duration;
+//!
+//! obvhs' traversal keeps the groups still to visit on a fixed 32-entry stack that, when full,
+//! overwrites its top entry: a BVH deeper than 31 inner levels (hundreds of coincident triangles, whose
+//! identical boxes PLOC pairs into a chain) would silently skip nodes. [`Bvh::build`] measures the
+//! depth, and traversals of a deeper BVH use a growable stack instead ([`Walk`]); the common, shallow
+//! case keeps obvhs' fixed stack.
 
 use glam::{UVec2, Vec3, Vec3A};
 use obvhs::aabb::Aabb as BAabb;
-use obvhs::cwbvh::{builder::build_cwbvh, CwBvh};
+use obvhs::bvh2::reinsertion::ReinsertionOptimizer;
+use obvhs::cwbvh::{bvh2_to_cwbvh::bvh2_to_cwbvh, CwBvh};
+use obvhs::faststack::{FastStack, StackStack};
+use obvhs::ploc::PlocBuilder;
 use obvhs::ray::Ray;
 use obvhs::BvhBuildParams;
 
@@ -28,12 +35,17 @@ const NORMALISED_SIZE: f32 = 1000.0;
 const PAD: f32 = 1e-2;
 /// The `t` at which a shadow ray reaches its light sample in BVH space.
 const SEGMENT_T: f32 = 1e4;
+/// Entries of obvhs' fixed traversal stack (`TRAVERSAL_STACK_SIZE`, private there). Its `push` on a
+/// full stack overwrites the top entry, so it holds `FIXED_STACK - 1` entries without loss.
+const FIXED_STACK: usize = 32;
 
 /// A BVH over the scene's triangles.
 pub struct Bvh {
     cw: CwBvh,
     origin: Vec3,
     scale: f32,
+    /// Depth of the deepest inner node (the root is 0): the most entries a traversal stack holds.
+    depth: u32,
 }
 
 impl Bvh {
@@ -51,8 +63,20 @@ impl Bvh {
                 BAabb::new(lo, hi)
             })
             .collect();
-        let cw = build_cwbvh(&boxes, BvhBuildParams::medium_build(), &mut Duration::default());
-        Bvh { cw, origin, scale }
+        let cw = build_cwbvh(&boxes, BvhBuildParams::medium_build());
+        let depth = inner_depth(&cw);
+        Bvh { cw, origin, scale, depth }
+    }
+
+    /// Depth of the deepest inner node (the root is 0). Above 31, traversals use a growable stack.
+    pub fn depth(&self) -> u32 {
+        self.depth
+    }
+
+    /// Whether obvhs' fixed stack holds every entry a traversal of this BVH pushes: at most one per
+    /// inner level above the node visited, so at most [`Bvh::depth`].
+    fn fixed_stack_fits(&self) -> bool {
+        (self.depth as usize) < FIXED_STACK
     }
 
     /// Bytes used by the nodes and index array.
@@ -80,11 +104,28 @@ impl Bvh {
         t_min: f32,
         skip: Option<TriId>,
     ) -> Option<(TriId, f32)> {
+        if self.fixed_stack_fits() {
+            self.closest_hit_with(&mut StackStack::<UVec2, FIXED_STACK>::default(), scene, origin, dir, t_min, skip)
+        } else {
+            self.closest_hit_with(&mut Vec::with_capacity(self.depth as usize + 1), scene, origin, dir, t_min, skip)
+        }
+    }
+
+    /// [`Bvh::closest_hit_from`] with `stack` as the traversal stack.
+    fn closest_hit_with<S: FastStack<UVec2>>(
+        &self,
+        stack: &mut S,
+        scene: &Scene,
+        origin: Vec3,
+        dir: Vec3,
+        t_min: f32,
+        skip: Option<TriId>,
+    ) -> Option<(TriId, f32)> {
         let test = RayTest::new(origin, dir, t_min, f32::INFINITY);
         // Unit direction in normalised space: t_local = t_world * scale.
         let ray = Ray::new(self.to_local(origin), Vec3A::from(dir), 0.0, f32::INFINITY);
         let mut best: Option<(TriId, f32)> = None;
-        let mut state = self.cw.new_traversal(ray.direction);
+        let mut state = Walk::new(&self.cw, ray.direction, stack);
         let mut node;
         let mut r = ray;
         obvhs::traverse!(self.cw, node, state, node.intersect_ray(&r, state.oct_inv4), {
@@ -127,9 +168,24 @@ impl Visibility for BvhVisibility<'_> {
 /// deciding candidates with the shared [`blocks`] predicate: brute force's answer. The `bvh` mode, and
 /// the P-LIE modes for records that store no list ([`crate::lie::RecordKind::Scene`]), use it.
 pub(crate) fn segment_occluded(scene: &Scene, bvh: &Bvh, ray: &ShadowRay, ctx: &mut QueryCtx) -> bool {
+    if bvh.fixed_stack_fits() {
+        segment_occluded_with(&mut StackStack::<UVec2, FIXED_STACK>::default(), scene, bvh, ray, ctx)
+    } else {
+        segment_occluded_with(&mut Vec::with_capacity(bvh.depth as usize + 1), scene, bvh, ray, ctx)
+    }
+}
+
+/// [`segment_occluded`] with `stack` as the traversal stack.
+fn segment_occluded_with<S: FastStack<UVec2>>(
+    stack: &mut S,
+    scene: &Scene,
+    bvh: &Bvh,
+    ray: &ShadowRay,
+    ctx: &mut QueryCtx,
+) -> bool {
     let dir = Vec3A::from(ray.test.dir * (bvh.scale / SEGMENT_T));
     let r = Ray::new(bvh.to_local(ray.test.origin), dir, 0.0, SEGMENT_T * (1.0 + 1e-6));
-    let mut state = bvh.cw.new_traversal(r.direction);
+    let mut state = Walk::new(&bvh.cw, r.direction, stack);
     let mut node;
     let mut hit = false;
     'outer: {
@@ -142,4 +198,199 @@ pub(crate) fn segment_occluded(scene: &Scene, bvh: &Bvh, ray: &ShadowRay, ctx: &
         });
     }
     hit
+}
+
+/// obvhs' `build_cwbvh` (PLOC, reinsertion, conversion to BVH8) without its debug-build `validate`,
+/// which asserts that the depth fits obvhs' fixed stack: here a deeper BVH is valid ([`Walk`]).
+fn build_cwbvh(boxes: &[BAabb], config: BvhBuildParams) -> CwBvh {
+    let indices = (0..boxes.len() as u32).collect::<Vec<_>>();
+    let mut bvh2 = PlocBuilder::with_capacity(boxes.len()).build(
+        config.ploc_search_distance,
+        boxes,
+        indices,
+        config.sort_precision,
+        config.search_depth_threshold,
+    );
+    ReinsertionOptimizer::default().run(&mut bvh2, config.reinsertion_batch_ratio, None);
+    bvh2_to_cwbvh(&bvh2, config.max_prims_per_leaf.clamp(1, 3), true, false)
+}
+
+/// Depth of the deepest inner node of `cw` (the root is 0; 0 for an empty BVH). The inner children of
+/// a node are the `imask.count_ones()` nodes from its `child_base_idx` on.
+fn inner_depth(cw: &CwBvh) -> u32 {
+    let mut deepest = 0;
+    let mut todo = if cw.nodes.is_empty() { vec![] } else { vec![(0u32, 0u32)] };
+    while let Some((n, d)) = todo.pop() {
+        deepest = deepest.max(d);
+        let node = &cw.nodes[n as usize];
+        todo.extend((0..node.imask.count_ones()).map(|k| (node.child_base_idx + k, d + 1)));
+    }
+    deepest
+}
+
+/// The traversal state `obvhs::traverse!` works on (the fields of obvhs' `Traversal`), with a stack of
+/// our choosing: obvhs' fixed one or a growable `Vec`.
+struct Walk<S> {
+    stack: S,
+    current_group: UVec2,
+    primitive_group: UVec2,
+    oct_inv4: u32,
+    primitive_id: u32,
+    hitmask: u32,
+}
+
+impl<'a, S: FastStack<UVec2>> Walk<&'a mut S> {
+    /// The state at the root of `cw` for rays in direction `dir`, with `stack` emptied.
+    fn new(cw: &CwBvh, dir: Vec3A, stack: &'a mut S) -> Walk<&'a mut S> {
+        stack.clear();
+        let t = cw.new_traversal(dir);
+        Walk {
+            stack,
+            current_group: t.current_group,
+            primitive_group: t.primitive_group,
+            oct_inv4: t.oct_inv4,
+            primitive_id: t.primitive_id,
+            hitmask: t.hitmask,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::{LightId, SceneBuilder};
+    use crate::visibility::Brute;
+
+    /// A 20 x 20 grid of floor quads, `copies` copies of one triangle at height 1 above part of it,
+    /// 60 small distinct blockers between them and the light (a quad at height 3).
+    fn scene_with_copies(copies: usize) -> Scene {
+        let mut b = SceneBuilder::new("copies");
+        let m = b.diffuse("white", Vec3::splat(0.5));
+        for i in 0..20 {
+            for j in 0..20 {
+                let (x, z) = (i as f32 * 0.2 - 2.0, j as f32 * 0.2 - 2.0);
+                let p = |dx: f32, dz: f32| Vec3::new(x + dx, 0.0, z + dz);
+                b.quad(p(0.0, 0.0), p(0.0, 0.2), p(0.2, 0.2), p(0.2, 0.0), m);
+            }
+        }
+        for _ in 0..copies {
+            b.triangle(Vec3::new(-1.0, 1.0, -1.0), Vec3::new(-1.0, 1.0, 1.0), Vec3::new(1.0, 1.0, 0.0), m);
+        }
+        for k in 0..60 {
+            let a = k as f32 * 0.61;
+            let c = Vec3::new(1.6 * a.cos() * (k as f32 / 60.0), 1.5 + 0.01 * k as f32, 1.6 * a.sin());
+            b.triangle(c, c + Vec3::new(0.0, 0.0, 0.3), c + Vec3::new(0.3, 0.02, 0.0), m);
+        }
+        let l = |x: f32, z: f32| Vec3::new(x, 3.0, z);
+        b.light("light", &[l(-1.5, -1.5), l(1.5, -1.5), l(1.5, 1.5), l(-1.5, 1.5)], Vec3::ONE);
+        b.build().unwrap()
+    }
+
+    /// Shadow rays from every floor triangle's centre to a 5 x 5 grid of light samples.
+    fn shadow_rays(scene: &Scene) -> Vec<ShadowRay> {
+        let mut rays = Vec::new();
+        for (t, tri) in scene.triangles.iter().enumerate().filter(|(_, tri)| tri.v.iter().all(|v| v.y == 0.0)) {
+            let x = (tri.v[0] + tri.v[1] + tri.v[2]) / 3.0;
+            for i in 0..5 {
+                for j in 0..5 {
+                    let y = Vec3::new(i as f32 * 0.7 - 1.4, 3.0, j as f32 * 0.7 - 1.4);
+                    rays.push(ShadowRay::new(x, y, LightId(0), TriId(t as u32), None));
+                }
+            }
+        }
+        rays
+    }
+
+    /// Brute force's nearest hit of `origin + t dir`, `t > 0`.
+    fn nearest(scene: &Scene, origin: Vec3, dir: Vec3) -> Option<f32> {
+        let test = RayTest::new(origin, dir, 0.0, f32::INFINITY);
+        scene.triangles.iter().filter_map(|t| test.hit(t)).reduce(f32::min)
+    }
+
+    /// A growable stack that records the most entries it held.
+    #[derive(Default)]
+    struct PeakStack {
+        items: Vec<UVec2>,
+        peak: usize,
+    }
+
+    impl FastStack<UVec2> for PeakStack {
+        fn push(&mut self, v: UVec2) {
+            self.items.push(v);
+            self.peak = self.peak.max(self.items.len());
+        }
+        fn pop_fast(&mut self) -> UVec2 {
+            self.items.pop().unwrap()
+        }
+        fn pop(&mut self) -> Option<UVec2> {
+            self.items.pop()
+        }
+        fn len(&self) -> usize {
+            self.items.len()
+        }
+        fn is_empty(&self) -> bool {
+            self.items.is_empty()
+        }
+        fn clear(&mut self) {
+            self.items.clear()
+        }
+    }
+
+    /// Checks every shadow ray and a fan of eye rays of `scene` against brute force; returns the most
+    /// entries a traversal stack held.
+    fn check_against_brute(scene: &Scene, bvh: &Bvh) -> usize {
+        let brute = Brute::new(scene);
+        let mut ctx = QueryCtx::new(scene.triangles.len());
+        let mut peak = PeakStack::default();
+        let mut occluded = 0;
+        let rays = shadow_rays(scene);
+        for (i, ray) in rays.iter().enumerate() {
+            let expected = brute.occluded(ray, &mut ctx);
+            assert_eq!(segment_occluded(scene, bvh, ray, &mut ctx), expected, "shadow ray {i}: {ray:?}");
+            assert_eq!(segment_occluded_with(&mut peak, scene, bvh, ray, &mut ctx), expected, "shadow ray {i}");
+            occluded += expected as usize;
+        }
+        // Both answers occur, so a traversal that found nothing or everything would fail.
+        assert!(occluded > rays.len() / 10 && occluded < rays.len() * 9 / 10, "{occluded} of {}", rays.len());
+        for i in 0..40 {
+            for j in 0..40 {
+                let origin = Vec3::new(0.3, 5.0, -0.2);
+                let dir = (Vec3::new(i as f32 * 0.11 - 2.2, 0.0, j as f32 * 0.11 - 2.2) - origin).normalize();
+                let expected = nearest(scene, origin, dir);
+                let got = bvh.closest_hit(scene, origin, dir).map(|(_, t)| t);
+                assert_eq!(got, expected, "eye ray {i},{j}");
+                let got = bvh.closest_hit_with(&mut peak, scene, origin, dir, 0.0, None).map(|(_, t)| t);
+                assert_eq!(got, expected, "eye ray {i},{j}");
+            }
+        }
+        peak.peak
+    }
+
+    #[test]
+    fn deep_bvh_answers_every_ray_as_brute_force() {
+        let scene = scene_with_copies(400);
+        let bvh = Bvh::build(&scene);
+        // Deeper than obvhs' fixed stack holds: the growable stack is the one used.
+        assert!(bvh.depth() as usize >= FIXED_STACK, "depth {}", bvh.depth());
+        assert!(!bvh.fixed_stack_fits());
+        let peak = check_against_brute(&scene, &bvh);
+        // The bound the choice of stack relies on. (Here a chain: the peak stays far below the depth.)
+        assert!(peak <= bvh.depth() as usize, "peak {peak} > depth {}", bvh.depth());
+    }
+
+    #[test]
+    fn shallow_bvh_keeps_the_fixed_stack() {
+        let scene = scene_with_copies(1);
+        let bvh = Bvh::build(&scene);
+        assert!(bvh.fixed_stack_fits(), "depth {}", bvh.depth());
+        let peak = check_against_brute(&scene, &bvh);
+        assert!(peak <= bvh.depth() as usize, "peak {peak} > depth {}", bvh.depth());
+    }
+
+    #[test]
+    fn depth_of_an_empty_and_a_one_box_bvh() {
+        assert_eq!(inner_depth(&CwBvh::default()), 0);
+        let one = build_cwbvh(&[BAabb::new(Vec3A::ZERO, Vec3A::ONE)], BvhBuildParams::medium_build());
+        assert_eq!(inner_depth(&one), 0);
+    }
 }
