@@ -231,9 +231,9 @@ fn fuzz_glb() {
 
 #[test]
 fn fuzz_plie() {
-    let bytes = targets::plie_seed().1.clone();
-    fuzz("plie", "plie", &[bytes.clone()], |b| targets::plie_file(b, false));
-    fuzz("plie-checksummed", "plie", &[bytes], |b| targets::plie_file(b, true));
+    let seeds = [targets::plie_seed().1.clone()];
+    fuzz("plie", "plie", &seeds, |b| targets::plie_file(b, false));
+    fuzz("plie-checksummed", "plie", &seeds, |b| targets::plie_file(b, true));
 }
 
 /// The `.plie` targets reach past the loader: their seed loads, so `verify` runs on what loads.

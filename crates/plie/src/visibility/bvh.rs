@@ -14,7 +14,12 @@
 //! overwrites its top entry: a BVH deeper than 31 inner levels (hundreds of coincident triangles, whose
 //! identical boxes PLOC pairs into a chain) would silently skip nodes. [`Bvh::build`] measures the
 //! depth, and traversals of a deeper BVH use a growable stack instead ([`Walk`]); the common, shallow
-//! case keeps obvhs' fixed stack.
+//! case keeps obvhs' fixed stack. Boxes with one centre (exact copies, instances with one transform,
+//! triangles nested around a point) also made PLOC's build quadratic (5,000 copies of a triangle:
+//! 1.5 s and a depth of 713; 20,000 glTF instances: 70 s): PLOC orders boxes by the Morton code of
+//! their centres and cannot order equal codes. So more than [`CROWD_LIMIT`] boxes whose centres share
+//! a Morton cell become one primitive listing their triangles ([`Groups`]); ordinary scenes have no
+//! such crowd and keep one primitive per triangle.
 
 use glam::{UVec2, Vec3, Vec3A};
 use obvhs::aabb::Aabb as BAabb;
@@ -24,6 +29,7 @@ use obvhs::faststack::{FastStack, StackStack};
 use obvhs::ploc::PlocBuilder;
 use obvhs::ray::Ray;
 use obvhs::BvhBuildParams;
+use rayon::prelude::*;
 
 use super::{blocks, QueryCtx, ShadowRay, Visibility};
 use crate::geometry::RayTest;
@@ -39,6 +45,10 @@ const SEGMENT_T: f32 = 1e4;
 /// full stack overwrites the top entry, so it holds `FIXED_STACK - 1` entries without loss.
 const FIXED_STACK: usize = 32;
 
+/// More boxes than this with their centres in one Morton cell ([`group_crowded_centres`]) are one
+/// BVH primitive. Two is common (both halves of an axis-aligned rectangle share their box), more rare.
+pub const CROWD_LIMIT: usize = 8;
+
 /// A BVH over the scene's triangles.
 pub struct Bvh {
     cw: CwBvh,
@@ -46,11 +56,67 @@ pub struct Bvh {
     scale: f32,
     /// Depth of the deepest inner node (the root is 0): the most entries a traversal stack holds.
     depth: u32,
+    /// The triangles of each primitive when some centres were crowded ([`CROWD_LIMIT`]); else every
+    /// primitive is the triangle of the same index.
+    groups: Option<Groups>,
+}
+
+/// The triangles of each BVH primitive `p`: `tris[starts[p]..starts[p + 1]]`.
+struct Groups {
+    starts: Vec<u32>,
+    tris: Vec<u32>,
+}
+
+/// The triangles of a BVH primitive. Traversals are compiled for each kind, so the common one
+/// ([`Single`]) pays nothing for the other.
+trait Prims {
+    /// The triangles of primitive `*p` (`p` points into the BVH's primitive index array).
+    fn of<'a>(&'a self, p: &'a u32) -> &'a [u32];
+}
+
+/// Every primitive is the triangle of the same index.
+struct Single;
+
+impl Prims for Single {
+    #[inline(always)]
+    fn of<'a>(&'a self, p: &'a u32) -> &'a [u32] {
+        std::slice::from_ref(p)
+    }
+}
+
+impl Prims for Groups {
+    #[inline(always)]
+    fn of<'a>(&'a self, p: &'a u32) -> &'a [u32] {
+        &self.tris[self.starts[*p as usize] as usize..self.starts[*p as usize + 1] as usize]
+    }
+}
+
+/// Calls `$f($stack, $prims, args...)` with the traversal stack and primitive kind `$bvh` needs.
+macro_rules! dispatch {
+    ($bvh:expr, $f:expr $(, $arg:expr)*) => {{
+        let deep = || Vec::with_capacity($bvh.depth as usize + 1);
+        match (&$bvh.groups, $bvh.fixed_stack_fits()) {
+            (None, true) => $f(&mut StackStack::<UVec2, FIXED_STACK>::default(), &Single, $($arg),*),
+            (None, false) => $f(&mut deep(), &Single, $($arg),*),
+            (Some(g), true) => $f(&mut StackStack::<UVec2, FIXED_STACK>::default(), g, $($arg),*),
+            (Some(g), false) => $f(&mut deep(), g, $($arg),*),
+        }
+    }};
 }
 
 impl Bvh {
     /// Builds the BVH (in parallel).
     pub fn build(scene: &Scene) -> Bvh {
+        Bvh::build_with(scene, true)
+    }
+
+    /// As [`Bvh::build`], one primitive per triangle even where centres crowd (for tests of deep BVHs).
+    #[cfg(test)]
+    fn build_ungrouped(scene: &Scene) -> Bvh {
+        Bvh::build_with(scene, false)
+    }
+
+    fn build_with(scene: &Scene, group: bool) -> Bvh {
         let origin = scene.bounds.min;
         let scale = NORMALISED_SIZE / scene.scale().max(f32::MIN_POSITIVE);
         let boxes: Vec<BAabb> = scene
@@ -63,9 +129,17 @@ impl Bvh {
                 BAabb::new(lo, hi)
             })
             .collect();
-        let cw = build_cwbvh(&boxes, BvhBuildParams::medium_build());
+        let (cw, groups) = match group.then(|| group_crowded_centres(&boxes)).flatten() {
+            None => (build_cwbvh(&boxes, BvhBuildParams::medium_build()), None),
+            Some((prim_boxes, groups)) => (build_cwbvh(&prim_boxes, BvhBuildParams::medium_build()), Some(groups)),
+        };
         let depth = inner_depth(&cw);
-        Bvh { cw, origin, scale, depth }
+        Bvh { cw, origin, scale, depth, groups }
+    }
+
+    /// Number of BVH primitives (triangles, or groups of triangles with crowded centres).
+    pub fn primitive_count(&self) -> usize {
+        self.cw.primitive_indices.len()
     }
 
     /// Depth of the deepest inner node (the root is 0). Above 31, traversals use a growable stack.
@@ -81,7 +155,8 @@ impl Bvh {
 
     /// Bytes used by the nodes and index array.
     pub fn memory_bytes(&self) -> usize {
-        self.cw.nodes.len() * std::mem::size_of_val(&self.cw.nodes[0]) + self.cw.primitive_indices.len() * 4
+        let groups = self.groups.as_ref().map_or(0, |g| (g.starts.len() + g.tris.len()) * 4);
+        self.cw.nodes.len() * std::mem::size_of_val(&self.cw.nodes[0]) + self.cw.primitive_indices.len() * 4 + groups
     }
 
     fn to_local(&self, p: Vec3) -> Vec3A {
@@ -104,17 +179,15 @@ impl Bvh {
         t_min: f32,
         skip: Option<TriId>,
     ) -> Option<(TriId, f32)> {
-        if self.fixed_stack_fits() {
-            self.closest_hit_with(&mut StackStack::<UVec2, FIXED_STACK>::default(), scene, origin, dir, t_min, skip)
-        } else {
-            self.closest_hit_with(&mut Vec::with_capacity(self.depth as usize + 1), scene, origin, dir, t_min, skip)
-        }
+        dispatch!(self, |st, pr| self.closest_hit_with(st, pr, scene, origin, dir, t_min, skip))
     }
 
     /// [`Bvh::closest_hit_from`] with `stack` as the traversal stack.
-    fn closest_hit_with<S: FastStack<UVec2>>(
+    #[allow(clippy::too_many_arguments)]
+    fn closest_hit_with<S: FastStack<UVec2>, P: Prims>(
         &self,
         stack: &mut S,
+        prims: &P,
         scene: &Scene,
         origin: Vec3,
         dir: Vec3,
@@ -129,15 +202,16 @@ impl Bvh {
         let mut node;
         let mut r = ray;
         obvhs::traverse!(self.cw, node, state, node.intersect_ray(&r, state.oct_inv4), {
-            let tri = self.cw.primitive_indices[state.primitive_id as usize];
-            if skip == Some(TriId(tri)) {
-                continue;
-            }
-            if let Some(t) = test.hit(&scene.triangles[tri as usize]) {
-                let tl = t * self.scale;
-                if tl < r.tmax {
-                    r.tmax = tl;
-                    best = Some((TriId(tri), t));
+            for &tri in prims.of(&self.cw.primitive_indices[state.primitive_id as usize]) {
+                if skip == Some(TriId(tri)) {
+                    continue;
+                }
+                if let Some(t) = test.hit(&scene.triangles[tri as usize]) {
+                    let tl = t * self.scale;
+                    if tl < r.tmax {
+                        r.tmax = tl;
+                        best = Some((TriId(tri), t));
+                    }
                 }
             }
         });
@@ -168,16 +242,13 @@ impl Visibility for BvhVisibility<'_> {
 /// deciding candidates with the shared [`blocks`] predicate: brute force's answer. The `bvh` mode, and
 /// the P-LIE modes for records that store no list ([`crate::lie::RecordKind::Scene`]), use it.
 pub(crate) fn segment_occluded(scene: &Scene, bvh: &Bvh, ray: &ShadowRay, ctx: &mut QueryCtx) -> bool {
-    if bvh.fixed_stack_fits() {
-        segment_occluded_with(&mut StackStack::<UVec2, FIXED_STACK>::default(), scene, bvh, ray, ctx)
-    } else {
-        segment_occluded_with(&mut Vec::with_capacity(bvh.depth as usize + 1), scene, bvh, ray, ctx)
-    }
+    dispatch!(bvh, segment_occluded_with, scene, bvh, ray, ctx)
 }
 
 /// [`segment_occluded`] with `stack` as the traversal stack.
-fn segment_occluded_with<S: FastStack<UVec2>>(
+fn segment_occluded_with<S: FastStack<UVec2>, P: Prims>(
     stack: &mut S,
+    prims: &P,
     scene: &Scene,
     bvh: &Bvh,
     ray: &ShadowRay,
@@ -190,10 +261,11 @@ fn segment_occluded_with<S: FastStack<UVec2>>(
     let mut hit = false;
     'outer: {
         obvhs::traverse!(bvh.cw, node, state, node.intersect_ray(&r, state.oct_inv4), {
-            let tri = TriId(bvh.cw.primitive_indices[state.primitive_id as usize]);
-            if blocks(scene, ray, tri, ctx) {
-                hit = true;
-                break 'outer;
+            for &tri in prims.of(&bvh.cw.primitive_indices[state.primitive_id as usize]) {
+                if blocks(scene, ray, TriId(tri), ctx) {
+                    hit = true;
+                    break 'outer;
+                }
             }
         });
     }
@@ -213,6 +285,62 @@ fn build_cwbvh(boxes: &[BAabb], config: BvhBuildParams) -> CwBvh {
     );
     ReinsertionOptimizer::default().run(&mut bvh2, config.reinsertion_batch_ratio, None);
     bvh2_to_cwbvh(&bvh2, config.max_prims_per_leaf.clamp(1, 3), true, false)
+}
+
+/// Cells per axis of the grid that [`group_crowded_centres`] puts box centres in: 2^21, the
+/// resolution of the 63-bit Morton codes PLOC sorts by (`SortPrecision::U64`).
+const CENTRE_CELLS: f64 = (1u32 << 21) as f64;
+
+/// When more than [`CROWD_LIMIT`] boxes have their centres in one cell of a 2^21-per-axis grid over
+/// the normalised scene (so one Morton code, which PLOC cannot order: exact copies, instances with
+/// one transform, or triangles nested around one centre): the primitives' boxes (one per crowded
+/// cell, the union of its boxes, and one per other triangle, in order of first appearance) and their
+/// triangles.
+fn group_crowded_centres(boxes: &[BAabb]) -> Option<(Vec<BAabb>, Groups)> {
+    let span = f64::from(NORMALISED_SIZE + 2.0 * PAD);
+    // The cell as one number: 21 bits per axis.
+    let cell = |b: &BAabb| {
+        let c = (b.min + b.max) * 0.5;
+        let [x, y, z] =
+            c.to_array().map(|x| ((f64::from(x + PAD) / span * CENTRE_CELLS).clamp(0.0, CENTRE_CELLS - 1.0)) as u64);
+        x << 42 | y << 21 | z
+    };
+    let cells: Vec<u64> = boxes.par_iter().map(cell).collect();
+    // Whether any cell holds more than the limit: sorted, a crowd is a run (the common case ends here).
+    let mut sorted = cells.clone();
+    sorted.par_sort_unstable();
+    if !sorted.windows(CROWD_LIMIT + 1).any(|w| w[0] == w[CROWD_LIMIT]) {
+        return None;
+    }
+    let mut count = std::collections::HashMap::new();
+    for run in sorted.chunk_by(|a, b| a == b) {
+        count.insert(run[0], run.len());
+    }
+    let mut crowd = std::collections::HashMap::new();
+    let mut members: Vec<Vec<u32>> = Vec::new();
+    let mut prim_boxes: Vec<BAabb> = Vec::new();
+    for (t, (b, c)) in boxes.iter().zip(&cells).enumerate() {
+        if count[c] > CROWD_LIMIT {
+            let p = *crowd.entry(*c).or_insert_with(|| {
+                prim_boxes.push(*b);
+                members.push(Vec::new());
+                members.len() - 1
+            });
+            prim_boxes[p] = prim_boxes[p].union(b);
+            members[p].push(t as u32);
+        } else {
+            prim_boxes.push(*b);
+            members.push(vec![t as u32]);
+        }
+    }
+    let mut starts = Vec::with_capacity(members.len() + 1);
+    let mut tris = Vec::with_capacity(boxes.len());
+    starts.push(0);
+    for m in members {
+        tris.extend(m);
+        starts.push(tris.len() as u32);
+    }
+    Some((prim_boxes, Groups { starts, tris }))
 }
 
 /// Depth of the deepest inner node of `cw` (the root is 0; 0 for an empty BVH). The inner children of
@@ -261,9 +389,10 @@ mod tests {
     use crate::scene::{LightId, SceneBuilder};
     use crate::visibility::Brute;
 
-    /// A 20 x 20 grid of floor quads, `copies` copies of one triangle at height 1 above part of it,
-    /// 60 small distinct blockers between them and the light (a quad at height 3).
-    fn scene_with_copies(copies: usize) -> Scene {
+    /// A 20 x 20 grid of floor quads, `copies` copies of a triangle at height 1 above part of it, the
+    /// `k`-th `1 + k * grow` times as wide (the same box centre), 60 small distinct blockers between
+    /// them and the light (a quad at height 3).
+    fn scene_with_copies(copies: usize, grow: f32) -> Scene {
         let mut b = SceneBuilder::new("copies");
         let m = b.diffuse("white", Vec3::splat(0.5));
         for i in 0..20 {
@@ -273,8 +402,9 @@ mod tests {
                 b.quad(p(0.0, 0.0), p(0.0, 0.2), p(0.2, 0.2), p(0.2, 0.0), m);
             }
         }
-        for _ in 0..copies {
-            b.triangle(Vec3::new(-1.0, 1.0, -1.0), Vec3::new(-1.0, 1.0, 1.0), Vec3::new(1.0, 1.0, 0.0), m);
+        for k in 0..copies {
+            let r = 1.0 + k as f32 * grow;
+            b.triangle(Vec3::new(-r, 1.0, -r), Vec3::new(-r, 1.0, r), Vec3::new(r, 1.0, 0.0), m);
         }
         for k in 0..60 {
             let a = k as f32 * 0.61;
@@ -347,7 +477,11 @@ mod tests {
         for (i, ray) in rays.iter().enumerate() {
             let expected = brute.occluded(ray, &mut ctx);
             assert_eq!(segment_occluded(scene, bvh, ray, &mut ctx), expected, "shadow ray {i}: {ray:?}");
-            assert_eq!(segment_occluded_with(&mut peak, scene, bvh, ray, &mut ctx), expected, "shadow ray {i}");
+            let got = match &bvh.groups {
+                None => segment_occluded_with(&mut peak, &Single, scene, bvh, ray, &mut ctx),
+                Some(g) => segment_occluded_with(&mut peak, g, scene, bvh, ray, &mut ctx),
+            };
+            assert_eq!(got, expected, "shadow ray {i}");
             occluded += expected as usize;
         }
         // Both answers occur, so a traversal that found nothing or everything would fail.
@@ -359,28 +493,63 @@ mod tests {
                 let expected = nearest(scene, origin, dir);
                 let got = bvh.closest_hit(scene, origin, dir).map(|(_, t)| t);
                 assert_eq!(got, expected, "eye ray {i},{j}");
-                let got = bvh.closest_hit_with(&mut peak, scene, origin, dir, 0.0, None).map(|(_, t)| t);
+                let got = match &bvh.groups {
+                    None => bvh.closest_hit_with(&mut peak, &Single, scene, origin, dir, 0.0, None),
+                    Some(g) => bvh.closest_hit_with(&mut peak, g, scene, origin, dir, 0.0, None),
+                };
+                let got = got.map(|(_, t)| t);
                 assert_eq!(got, expected, "eye ray {i},{j}");
             }
         }
         peak.peak
     }
 
+    /// 2,000 copies of a triangle, each 1e-4 wider than the last: distinct boxes around one centre,
+    /// which PLOC stacks into a BVH deeper than obvhs' fixed stack holds. (Built without grouping
+    /// crowded centres, which would make them one primitive.)
     #[test]
     fn deep_bvh_answers_every_ray_as_brute_force() {
-        let scene = scene_with_copies(400);
-        let bvh = Bvh::build(&scene);
+        let scene = scene_with_copies(2000, 1e-4);
+        let bvh = Bvh::build_ungrouped(&scene);
         // Deeper than obvhs' fixed stack holds: the growable stack is the one used.
         assert!(bvh.depth() as usize >= FIXED_STACK, "depth {}", bvh.depth());
         assert!(!bvh.fixed_stack_fits());
         let peak = check_against_brute(&scene, &bvh);
-        // The bound the choice of stack relies on. (Here a chain: the peak stays far below the depth.)
+        eprintln!("deep BVH: depth {}, at most {peak} stack entries", bvh.depth());
+        // The bound the choice of stack relies on.
         assert!(peak <= bvh.depth() as usize, "peak {peak} > depth {}", bvh.depth());
+    }
+
+    /// 400 exact copies (the 1,200-index face), and 2,000 triangles nested around one centre:
+    /// one primitive lists them all, and the BVH is shallow (without the grouping it was deeper than
+    /// the fixed stack, and PLOC's build quadratic).
+    #[test]
+    fn crowded_centres_are_one_primitive() {
+        for (copies, grow) in [(400, 0.0), (2000, 1e-4)] {
+            let scene = scene_with_copies(copies, grow);
+            let bvh = Bvh::build(&scene);
+            // The copies' centres fall in one cell, or a few where rounding straddles a cell's side.
+            let others = scene.triangles.len() - copies;
+            let prims = bvh.primitive_count();
+            assert!(prims > others && prims <= others + 4, "{copies} copies: {prims} primitives");
+            assert!(bvh.fixed_stack_fits(), "{copies} copies: depth {}", bvh.depth());
+            let peak = check_against_brute(&scene, &bvh);
+            assert!(peak <= bvh.depth() as usize, "peak {peak} > depth {}", bvh.depth());
+        }
+    }
+
+    /// Up to [`CROWD_LIMIT`] triangles sharing a box stay one primitive each.
+    #[test]
+    fn a_few_copies_stay_apart() {
+        let scene = scene_with_copies(CROWD_LIMIT, 0.0);
+        let bvh = Bvh::build(&scene);
+        assert_eq!(bvh.primitive_count(), scene.triangles.len());
+        check_against_brute(&scene, &bvh);
     }
 
     #[test]
     fn shallow_bvh_keeps_the_fixed_stack() {
-        let scene = scene_with_copies(1);
+        let scene = scene_with_copies(1, 0.0);
         let bvh = Bvh::build(&scene);
         assert!(bvh.fixed_stack_fits(), "depth {}", bvh.depth());
         let peak = check_against_brute(&scene, &bvh);

@@ -17,9 +17,12 @@ use plie::octree::{Octree, OctreeParams};
 use plie::visibility::bvh::Bvh;
 use plie::Scene;
 
+/// A target: what it does with one input.
+pub type Target = fn(&[u8]);
+
 /// Every target by name (the names of the cargo-fuzz binaries and of `fuzz/seeds/NAME/` and
 /// `fuzz/regressions/NAME/`).
-pub const TARGETS: &[(&str, fn(&[u8]))] =
+pub const TARGETS: &[(&str, Target)] =
     &[("obj", obj), ("mtl", mtl), ("gltf", gltf), ("glb", glb), ("plie", plie), ("plie_checksummed", plie_checksummed)];
 
 /// The companion files the scene targets write beside their input (the seeds of the stable fuzzer).
