@@ -29,6 +29,8 @@ if [ $# -gt 0 ]; then targets=("$@"); else mapfile -t targets < <(cargo fuzz lis
 mkdir -p logs
 run_one() {
     local t=$1
+    # Earlier findings are in regressions/ already: keep only this run's.
+    rm -rf "artifacts/$t"
     mkdir -p "corpus/$t" "artifacts/$t"
     # RAYON_NUM_THREADS=1: two targets share the two cores.
     if RAYON_NUM_THREADS=1 cargo fuzz run -s none "$t" "corpus/$t" "seeds/$t" -- \

@@ -12,7 +12,7 @@ use std::time::Instant;
 
 use anyhow::{Context, Result};
 use plie::construct::refine::RefineParams;
-use plie::lie::{Plie, PlieParams};
+use plie::lie::{Grids, Plie, PlieParams, Propagation, Regions};
 use plie::octree::Octree;
 use plie::render::shade::shade;
 use plie::render::{HitBuffer, NoProgress, Progress};
@@ -321,17 +321,18 @@ fn bench_scene(name: &str, plan: &Plan, one: &rayon::ThreadPool, bar: &Bar) -> R
     // The thesis' test-1 parameters with the default blocker cap (issue 15), as `plie build` uses.
     let thesis = PlieParams::thesis().bounded();
     thesis.octree().validate()?;
-    let (octree, octree_seconds) = timed(plan.runs, || Octree::build(&scene, thesis.octree()));
+    let (octree, octree_seconds) =
+        timed(plan.runs, || Octree::build(&scene, thesis.octree()).expect("valid octree parameters"));
     let (_, lie, b1) = build_plie(&scene, &octree, thesis, "thesis", plan.runs);
     let (_, grid, b2) = build_plie(&scene, &octree, PlieParams::default().bounded(), "grids", plan.runs);
-    let no_regions = PlieParams { regions: false, ..thesis };
+    let no_regions = PlieParams { regions: Regions::Skip, ..thesis };
     let (_, _, b3) = build_plie(&scene, &octree, no_regions, "blockers-only", plan.runs);
-    let no_propagation = PlieParams { propagation: false, ..thesis };
+    let no_propagation = PlieParams { propagation: Propagation::Off, ..thesis };
     let (_, _, b4) = build_plie(&scene, &octree, no_propagation, "no-propagation", plan.runs);
     let refined = PlieParams { refine: RefineParams::thesis_umbra(), ..thesis };
     let (r_octree, r_lie, b5) = build_plie(&scene, &octree, refined, "refined", plan.runs);
     let (_, r_grid, b6) =
-        build_plie(&scene, &octree, PlieParams { grids: true, ..refined }, "refined-grids", plan.runs);
+        build_plie(&scene, &octree, PlieParams { grids: Grids::Build, ..refined }, "refined-grids", plan.runs);
     bar.advance(1);
     let s = Structures { scene: &scene, bvh: &bvh, octree: &octree, lie: &lie, grid: &grid };
     let r = Structures { scene: &scene, bvh: &bvh, octree: &r_octree, lie: &r_lie, grid: &r_grid };

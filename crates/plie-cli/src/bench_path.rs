@@ -77,7 +77,7 @@ pub fn run(plan: &PathPlan, out: &Path, bar: &Bar) -> Result<()> {
         let camera: Camera = CameraArgs { eye, target, up: None, fov }.camera(&scene)?;
         let bvh = Bvh::build(&scene);
         let params = PlieParams::default();
-        let octree = Octree::build(&scene, params.octree());
+        let octree = Octree::build(&scene, params.octree())?;
         let t = std::time::Instant::now();
         let grid = modes
             .iter()

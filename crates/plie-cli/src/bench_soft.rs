@@ -138,7 +138,7 @@ pub fn run(scenes: &[String], out: &Path, runs: usize, quiet: bool) -> Result<()
         }
         let bvh = Bvh::build(&scene);
         let params = PlieParams::default();
-        let octree = Octree::build(&scene, params.octree());
+        let octree = Octree::build(&scene, params.octree())?;
         let plie = plie::construct::build_refined(&scene, octree.clone(), params, &NoProgress).plie;
         let refine = RefineParams { umbra_full: true, umbra_free: true, ..RefineParams::none() };
         let refined =

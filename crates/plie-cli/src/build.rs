@@ -54,7 +54,7 @@ pub fn run(a: &Args) -> Result<()> {
     let bar = Bar::new(a.quiet || a.json);
     let t_all = Instant::now();
     let t = Instant::now();
-    let octree = Octree::build(&scene, params.octree());
+    let octree = Octree::build(&scene, params.octree())?;
     let octree_seconds = t.elapsed().as_secs_f64();
     let built = plie::construct::build_bounded(&scene, octree, params, limits, &bar)
         .context("P-LIE construction stopped by Ctrl-C; nothing was written")?;
@@ -70,7 +70,7 @@ pub fn run(a: &Args) -> Result<()> {
     let memory = plie.memory_bytes() + octree.memory_bytes();
     if a.json {
         let propagation = json!({
-            "enabled": params.propagation,
+            "enabled": params.propagation == plie::lie::Propagation::On,
             "records_removed": stats.records_removed_propagation,
             "tests": stats.propagation_tests,
             "by_rule": stats.propagation_by_rule,
@@ -118,7 +118,7 @@ pub fn run(a: &Args) -> Result<()> {
             "blockers_total": stats.blockers_total,
             "blockers_mean": stats.blockers_mean,
             "blockers_max": stats.blockers_max,
-            "regions": params.regions,
+            "regions": params.has_regions(),
             "records_removed_umbra": stats.records_removed_umbra,
             "records_removed_propagation": stats.records_removed_propagation,
             "propagation": propagation,
@@ -171,7 +171,7 @@ pub fn run(a: &Args) -> Result<()> {
             params.blocker_cap.map_or("no cap".to_string(), |c| c.to_string()),
             stats.records_over_budget
         );
-        if !params.regions {
+        if !params.has_regions() {
             println!("regions         none (--no-regions)");
         } else {
             println!(
@@ -187,8 +187,8 @@ pub fn run(a: &Args) -> Result<()> {
                 stats.region_bytes
             );
         }
-        if !params.regions {
-        } else if !params.propagation {
+        if !params.has_regions() {
+        } else if !params.propagates() {
             println!("propagation     none (--no-propagation)");
         } else {
             println!(
@@ -210,7 +210,7 @@ pub fn run(a: &Args) -> Result<()> {
             );
         }
         print_refinement(&params, &stats);
-        if !params.grids {
+        if !params.has_grids() {
             println!("face grids      none (--no-grids)");
         } else {
             println!(

@@ -130,7 +130,7 @@ pub fn run(a: &Args) -> Result<()> {
 
     if let (Some(ins), Some(path), Some(kind)) = (&inspection, &a.output, kind) {
         if !a.quiet && !a.json {
-            describe(&octree, ins, plie.params.regions);
+            describe(&octree, ins, plie.params.has_regions());
         }
         let camera = if a.frame { camera_on_box(&camera, &ins.bounds) } else { camera };
         match kind {
@@ -156,7 +156,7 @@ pub fn run(a: &Args) -> Result<()> {
             v["summary"] = serde_json::to_value(s)?;
         }
         if let (Some(ins), Some(path)) = (&inspection, &a.output) {
-            v["inspection"] = inspection_json(&octree, ins, plie.params.regions);
+            v["inspection"] = inspection_json(&octree, ins, plie.params.has_regions());
             v["output"] = json!(path.display().to_string());
         }
         println!("{v}");

@@ -8,7 +8,7 @@ use std::time::Instant;
 use anyhow::{bail, Context, Result};
 use plie::construct::refine::{MaxBlockers, RefineParams};
 use plie::lie::Plie;
-use plie::lie::PlieParams;
+use plie::lie::{Grids, PlieParams, Propagation, Regions};
 use plie::octree::{Octree, OctreeParams};
 use plie::Scene;
 
@@ -109,14 +109,14 @@ impl PlieArgs {
         let p = PlieParams {
             max_triangles: self.max_triangles,
             max_depth: self.max_depth,
-            grids: want_grids && !self.no_grids,
-            regions: !self.no_regions,
-            propagation: !self.no_propagation,
+            grids: if want_grids && !self.no_grids { Grids::Build } else { Grids::Skip },
+            regions: if self.no_regions { Regions::Skip } else { Regions::Compute },
+            propagation: if self.no_propagation { Propagation::Off } else { Propagation::On },
             refine: self.refine_params()?,
             blocker_cap: self.blocker_cap.0,
         };
         p.octree().validate()?;
-        p.refine.validate(p.regions)?;
+        p.refine.validate(p.has_regions())?;
         Ok(p)
     }
 
@@ -161,7 +161,7 @@ pub fn load_or_build(scene: &Scene, params: PlieParams, path: Option<&Path>, bar
             .with_context(|| format!("cannot use P-LIE file {}", path.display()))?;
         return Ok(Loaded { octree, plie, build_seconds: None, load_seconds: Some(t.elapsed().as_secs_f64()) });
     }
-    let octree = Octree::build(scene, params.octree());
+    let octree = Octree::build(scene, params.octree())?;
     let t = Instant::now();
     let limits =
         plie::construct::Limits { list_bytes: Some(crate::budget::list_bytes(crate::budget::default_bytes(), scene)) };

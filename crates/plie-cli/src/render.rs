@@ -107,7 +107,7 @@ pub fn run(a: &Args) -> Result<()> {
         let mode = a.visibility.unwrap_or_else(|| best_mode(&got.plie.params));
         (mode, got.octree, Some(got.plie), got.build_seconds, got.load_seconds)
     } else {
-        (asked, Octree::build(&scene, params.octree()), None, None, None)
+        (asked, Octree::build(&scene, params.octree())?, None, None, None)
     };
     let octree_seconds = t.elapsed().as_secs_f64() - plie_seconds.unwrap_or(0.0);
     let vis = visibility::for_mode(mode, &scene, &bvh, &octree, plie.as_ref())?;
@@ -282,9 +282,9 @@ fn print_answers(s: &QueryStats) {
 
 /// The fastest mode a P-LIE supports: `grid` with face grids, else `penumbra` with regions, else `lie`.
 fn best_mode(params: &plie::lie::PlieParams) -> Mode {
-    if params.grids {
+    if params.has_grids() {
         Mode::Grid
-    } else if params.regions {
+    } else if params.has_regions() {
         Mode::Penumbra
     } else {
         Mode::Lie

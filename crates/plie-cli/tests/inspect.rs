@@ -24,7 +24,7 @@ fn arg(p: Vec3) -> String {
 /// cell, whose every lit face lies in umbra (SPEC §6).
 fn cornell_cell(name: &str) -> (plie::Scene, Octree, Vec3) {
     let scene = plie::scene::builtin::load(name).unwrap();
-    let octree = Octree::build(&scene, PlieParams::default().octree());
+    let octree = Octree::build(&scene, PlieParams::default().octree()).expect("valid octree parameters");
     let p = octree.root_bounds().center() + Vec3::new(1.0, -1.0, 1.0);
     (scene, octree, p)
 }

@@ -46,7 +46,7 @@ fn main() {
     for name in ["cornell-cube-3", "huis-a", "dragon", "boot"] {
         let scene = plie::scene::builtin::load(name).expect("built-in scene");
         let params = PlieParams::thesis();
-        let octree = Octree::build(&scene, params.octree());
+        let octree = Octree::build(&scene, params.octree()).expect("valid octree parameters");
         let (plie, _) = plie::construct::build(&scene, &octree, params, &NoProgress);
         let bvh = Bvh::build(&scene);
         let rays = rays(&scene, &octree);

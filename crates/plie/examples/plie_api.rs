@@ -17,7 +17,7 @@ fn main() -> plie::Result<()> {
 
     // Build once, independent of any camera.
     let params = PlieParams::thesis();
-    let octree = Octree::build(&scene, params.octree());
+    let octree = Octree::build(&scene, params.octree()).expect("valid octree parameters");
     let (plie, stats) = plie::construct::build(&scene, &octree, params, &NoProgress);
     println!(
         "built: {} leaves, {} records, {:.1} blockers per record",

@@ -42,6 +42,18 @@ pub enum Error {
     #[cfg(feature = "embree")]
     #[error("embree: {0}")]
     Embree(String),
+    /// A `.plie` file cannot be used: see [`PlieFileError`] for why.
+    #[error("{}: {problem}", path.display())]
+    PlieFile {
+        /// The file.
+        path: PathBuf,
+        /// What is wrong with it.
+        problem: PlieFileError,
+    },
+    /// The P-LIE construction was interrupted ([`crate::render::Progress::cancelled`]); nothing was
+    /// built.
+    #[error("interrupted")]
+    Interrupted,
     /// Encoding an image failed.
     #[error("{}: cannot write image: {message}", path.display())]
     Image {
@@ -54,3 +66,67 @@ pub enum Error {
 
 /// Result with [`Error`].
 pub type Result<T, E = Error> = std::result::Result<T, E>;
+
+/// Why a `.plie` file cannot be used ([`Error::PlieFile`]). Each message is one line.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum PlieFileError {
+    /// The file does not start with the `.plie` magic bytes.
+    #[error("not a .plie file (wrong magic bytes)")]
+    BadMagic,
+    /// The file is shorter than the header.
+    #[error("truncated .plie file (incomplete header)")]
+    TruncatedHeader,
+    /// Another format version.
+    #[error(
+        "made with .plie format version {found}; this plie reads version {supported}: rebuild it with `plie build`"
+    )]
+    Version {
+        /// The file's version.
+        found: u32,
+        /// The version this build reads.
+        supported: u32,
+    },
+    /// The payload is shorter than the header says.
+    #[error("truncated .plie file ({have} of {expected} payload bytes)")]
+    Truncated {
+        /// Payload bytes present.
+        have: u64,
+        /// Payload bytes the header announces.
+        expected: u64,
+    },
+    /// Bytes follow the payload.
+    #[error("corrupted .plie file ({extra} bytes after the payload)")]
+    TrailingBytes {
+        /// How many.
+        extra: u64,
+    },
+    /// The payload does not match its checksum.
+    #[error("corrupted .plie file (checksum mismatch)")]
+    Checksum,
+    /// The checksum matches but the payload does not decode.
+    #[error("corrupted .plie file: the checksum matches but the content is not a P-LIE (written by another program or altered): rebuild it with `plie build`")]
+    Undecodable,
+    /// The file was built for another scene.
+    #[error("was built for another scene, not '{scene}' (rebuild it with `plie build`)")]
+    OtherScene {
+        /// The scene it was loaded for.
+        scene: String,
+    },
+    /// The file was built with other parameters than the caller expects.
+    #[error("was built with other parameters ({file}) than asked for ({asked})")]
+    OtherParameters {
+        /// The file's parameters, as command-line options.
+        file: String,
+        /// The expected ones.
+        asked: String,
+    },
+    /// The parameters stored in the file are invalid.
+    #[error("invalid parameters in file: {0}")]
+    InvalidParameters(String),
+    /// The octree rebuilt for the scene is not the one the P-LIE was built on.
+    #[error("its octree differs from the one this plie builds for the scene: rebuild it")]
+    OtherOctree,
+    /// The P-LIE's tables are inconsistent (an index out of range, a list out of order...).
+    #[error("inconsistent .plie file: {0}")]
+    Inconsistent(String),
+}

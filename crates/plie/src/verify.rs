@@ -30,7 +30,7 @@ pub struct Report {
 /// Rebuilds the P-LIE of `scene` with `plie`'s parameters and compares it table by table. Returns
 /// the first difference as an error message.
 pub fn verify_full(scene: &Scene, plie: &Plie) -> Result<Report, String> {
-    let octree = Octree::build(scene, plie.params.octree());
+    let octree = Octree::build(scene, plie.params.octree()).map_err(|e| e.to_string())?;
     let built = crate::construct::build_refined(scene, octree, plie.params, &NoProgress).plie;
     first_difference(&built, plie)?;
     Ok(Report { records: plie.records.len(), rays: 0 })
@@ -78,8 +78,8 @@ pub fn verify_sample(
     let mut rng = SplitMix(seed ^ 0x0005_eed0_f91e);
     let modes: Vec<Mode> = [Mode::Lie, Mode::Umbra, Mode::Penumbra, Mode::Grid]
         .into_iter()
-        .filter(|m| !m.needs_regions() || plie.params.regions)
-        .filter(|m| *m != Mode::Grid || plie.params.grids)
+        .filter(|m| !m.needs_regions() || plie.params.has_regions())
+        .filter(|m| *m != Mode::Grid || plie.params.has_grids())
         .collect();
     let bvh = crate::visibility::bvh::Bvh::build(scene);
     let lie: Vec<LieVisibility> = modes.iter().map(|&m| LieVisibility::new(scene, &bvh, octree, plie, m)).collect();

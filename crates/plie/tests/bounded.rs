@@ -18,7 +18,14 @@ fn balusters() -> Scene {
 }
 
 fn build(scene: &Scene, params: PlieParams, limits: Limits) -> plie::construct::Built {
-    build_bounded(scene, Octree::build(scene, params.octree()), params, limits, &NoProgress).unwrap()
+    build_bounded(
+        scene,
+        Octree::build(scene, params.octree()).expect("valid octree parameters"),
+        params,
+        limits,
+        &NoProgress,
+    )
+    .unwrap()
 }
 
 /// Every exact P-LIE mode against brute force on `n` shadow rays; returns the rays answered by the
@@ -164,7 +171,13 @@ fn a_cancelled_construction_returns_interrupted() {
     let params = PlieParams::default();
     for after in [0, 5] {
         let stop = StopAfter { after, done: Default::default() };
-        let r = build_bounded(&scene, Octree::build(&scene, params.octree()), params, Limits::default(), &stop);
+        let r = build_bounded(
+            &scene,
+            Octree::build(&scene, params.octree()).expect("valid octree parameters"),
+            params,
+            Limits::default(),
+            &stop,
+        );
         assert_eq!(r.err(), Some(Interrupted), "after {after}");
     }
 }

@@ -8,7 +8,7 @@
 use glam::{Vec2, Vec3};
 use plie::construct::data_objects::{face_sees_light, thesis_face_sees_light};
 use plie::geometry::RayTest;
-use plie::lie::PlieParams;
+use plie::lie::{PlieParams, Regions};
 use plie::octree::{Dir, LeafId, Octree};
 use plie::render::NoProgress;
 use plie::visibility::Mode;
@@ -70,7 +70,7 @@ fn hits_any_t(scene: &Scene, a: Vec3, b: Vec3, t: usize) -> bool {
 fn blockers_contain_every_triangle_between_face_and_light() {
     let scene = room();
     let params = PlieParams { max_triangles: 8, ..PlieParams::thesis() };
-    let octree = Octree::build(&scene, params.octree());
+    let octree = Octree::build(&scene, params.octree()).expect("valid octree parameters");
     let (plie, stats) = plie::construct::build(&scene, &octree, params, &NoProgress);
     assert!(stats.records > 0 && stats.blockers_total > 0);
     let mut rng = Rng(3);
@@ -104,8 +104,8 @@ fn blockers_contain_every_triangle_between_face_and_light() {
 fn faces_without_a_record_receive_no_light() {
     // Without regions, so that no record is removed for being dark (tests/regions.rs checks those).
     let scene = room();
-    let params = PlieParams { max_triangles: 8, regions: false, ..PlieParams::thesis() };
-    let octree = Octree::build(&scene, params.octree());
+    let params = PlieParams { max_triangles: 8, regions: Regions::Skip, ..PlieParams::thesis() };
+    let octree = Octree::build(&scene, params.octree()).expect("valid octree parameters");
     let (plie, _) = plie::construct::build(&scene, &octree, params, &NoProgress);
     let light = &scene.lights[0];
     let mut rng = Rng(11);
@@ -163,7 +163,7 @@ fn lie_mode_matches_brute_force_in_the_room() {
     let scene = room();
     for max_triangles in [8, 200] {
         let params = PlieParams { max_triangles, ..PlieParams::default() };
-        let octree = Octree::build(&scene, params.octree());
+        let octree = Octree::build(&scene, params.octree()).expect("valid octree parameters");
         let (plie, stats) = plie::construct::build(&scene, &octree, params, &NoProgress);
         assert!(stats.grids > 0);
         let brute = Brute::new(&scene);
@@ -225,7 +225,7 @@ fn lie_mode_matches_brute_force_with_lights_tilted_to_grazing() {
         assert!(l.normal.y < 0.0 || i == 4, "light {i} normal {}", l.normal);
     }
     let params = PlieParams { max_triangles: 8, ..PlieParams::default() };
-    let octree = Octree::build(&scene, params.octree());
+    let octree = Octree::build(&scene, params.octree()).expect("valid octree parameters");
     let (plie, _) = plie::construct::build(&scene, &octree, params, &NoProgress);
     let brute = Brute::new(&scene);
     let bvh = plie::visibility::bvh::Bvh::build(&scene);
@@ -267,7 +267,7 @@ fn construction_does_not_depend_on_the_thread_count() {
         let build = |threads| {
             let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
             pool.install(|| {
-                let octree = Octree::build(&scene, params.octree());
+                let octree = Octree::build(&scene, params.octree()).expect("valid octree parameters");
                 plie::construct::build(&scene, &octree, params, &NoProgress)
             })
         };
@@ -284,7 +284,7 @@ fn grid_cells_contain_every_triangle_between_cell_and_light() {
     use plie::construct::grid::cell_box;
     let scene = room();
     let params = PlieParams { max_triangles: 64, ..PlieParams::default() };
-    let octree = Octree::build(&scene, params.octree());
+    let octree = Octree::build(&scene, params.octree()).expect("valid octree parameters");
     let (plie, stats) = plie::construct::build(&scene, &octree, params, &NoProgress);
     assert!(stats.grids > 0, "{stats:?}");
     let mut rng = Rng(23);

@@ -28,7 +28,7 @@ const SETTINGS: RenderSettings = RenderSettings { width: 64, height: 64, eye_ray
 
 fn check(scene: &Scene) {
     let bvh = Bvh::build(scene);
-    let octree = Octree::build(scene, plie::lie::PlieParams::default().octree());
+    let octree = Octree::build(scene, plie::lie::PlieParams::default().octree()).expect("valid octree parameters");
     let camera = scene.camera_or_default();
     let hits = HitBuffer::build(scene, &camera, (SETTINGS.width, SETTINGS.height, SETTINGS.eye_rays), &bvh, None);
     let native = NativeEmbree::new(scene).expect("Embree device");

@@ -6,7 +6,7 @@ use glam::Vec3;
 use plie::inspect::overlay::{overlay_scene, render_inspection, OverlayStyle};
 use plie::inspect::summary::Filter;
 use plie::inspect::{FaceStatus, Inspector};
-use plie::lie::{Plie, PlieParams};
+use plie::lie::{Plie, PlieParams, Regions};
 use plie::octree::{Dir, Octree};
 use plie::render::{render, HitBuffer, NoProgress, RenderSettings};
 use plie::visibility::bvh::Bvh;
@@ -14,7 +14,7 @@ use plie::visibility::BvhVisibility;
 use plie::{LightId, Scene};
 
 fn build(scene: &Scene, params: PlieParams) -> (Octree, Plie, plie::construct::BuildStats) {
-    let octree = Octree::build(scene, params.octree());
+    let octree = Octree::build(scene, params.octree()).expect("valid octree parameters");
     let (plie, stats) = plie::construct::build(scene, &octree, params, &NoProgress);
     (octree, plie, stats)
 }
@@ -54,7 +54,7 @@ fn removed_faces_show_the_builders_blockers_in_full_umbra() {
     let mut removed = 0;
     for scene in scenes() {
         let (octree, plie, _) = build(&scene, PlieParams::default());
-        let (_, bare, _) = build(&scene, PlieParams { regions: false, ..PlieParams::default() });
+        let (_, bare, _) = build(&scene, PlieParams { regions: Regions::Skip, ..PlieParams::default() });
         let ins = Inspector::new(&scene, &octree, &plie).unwrap();
         for leaf in octree.leaves() {
             for face in Dir::ALL {

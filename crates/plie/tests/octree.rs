@@ -261,7 +261,7 @@ fn segment(s: &Scene, o: &Octree, i: u64) -> (Vec3, Vec3, TriId) {
 fn triangles_are_in_exactly_the_leaves_they_overlap() {
     for s in scenes() {
         for params in param_sets(&s) {
-            let o = Octree::build(&s, params);
+            let o = Octree::build(&s, params).expect("valid octree parameters");
             let report = o.validate(&s);
             assert!(report.is_ok(), "{}: {report}", s.name);
             let eps = o.eps();
@@ -295,10 +295,10 @@ fn triangles_are_in_exactly_the_leaves_they_overlap() {
 fn generated_scenes_are_deep_where_they_should_be() {
     let s = sphere(40, 30);
     assert!(s.triangle_count() > 2000);
-    assert!(Octree::build(&s, OctreeParams::default()).depth() >= 3);
-    assert!(Octree::build(&s, SMALL).depth() >= 5);
+    assert!(Octree::build(&s, OctreeParams::default()).expect("valid octree parameters").depth() >= 3);
+    assert!(Octree::build(&s, SMALL).expect("valid octree parameters").depth() >= 5);
     let s = big_triangle();
-    let o = Octree::build(&s, SMALL);
+    let o = Octree::build(&s, SMALL).expect("valid octree parameters");
     let big = TriId(s.triangle_count() as u32 - 3); // before the two light triangles
     let holding = o.leaves().filter(|&l| o.leaf_triangles(l).contains(&big)).count();
     assert!(o.depth() >= 5 && holding >= 100, "depth {}, big triangle in {holding} leaves", o.depth());
@@ -308,7 +308,8 @@ fn generated_scenes_are_deep_where_they_should_be() {
 fn octree_visibility_matches_brute_force() {
     const SEGMENTS: u64 = 100_000;
     for s in scenes() {
-        let trees: Vec<Octree> = param_sets(&s).into_iter().map(|p| Octree::build(&s, p)).collect();
+        let trees: Vec<Octree> =
+            param_sets(&s).into_iter().map(|p| Octree::build(&s, p).expect("valid octree parameters")).collect();
         let brute = Brute::new(&s);
         let modes: Vec<OctreeVisibility> = trees.iter().map(|o| OctreeVisibility::new(&s, o)).collect();
         let (occluded, mismatches) = (0..SEGMENTS)
@@ -362,7 +363,7 @@ fn clip64(o: Vec3, d: Vec3, b: &Aabb) -> Option<(f64, f64)> {
 #[test]
 fn traversal_is_conservative_tight_and_front_to_back() {
     for s in [cornell(), sphere(40, 30), big_triangle(), random_triangles()] {
-        let o = Octree::build(&s, SMALL);
+        let o = Octree::build(&s, SMALL).expect("valid octree parameters");
         let eps = o.eps();
         for i in 0..1500u64 {
             let (x, y, _) = segment(&s, &o, i);
@@ -398,7 +399,7 @@ fn traversal_is_conservative_tight_and_front_to_back() {
 #[test]
 fn overlapping_boxes_match_brute_force() {
     let s = big_triangle();
-    let o = Octree::build(&s, SMALL);
+    let o = Octree::build(&s, SMALL).expect("valid octree parameters");
     let mut rng = Rng::new(3);
     for _ in 0..300 {
         let (a, b) = (leaf_point(&o, &mut rng).1, rng.in_box(&o.root_bounds().expanded(0.2)));
@@ -414,7 +415,7 @@ fn overlapping_boxes_match_brute_force() {
 #[test]
 fn locate_finds_the_leaf_and_breaks_ties_upwards() {
     for s in scenes() {
-        let o = Octree::build(&s, SMALL);
+        let o = Octree::build(&s, SMALL).expect("valid octree parameters");
         let root = o.root_bounds();
         // Every leaf's lower corner belongs to it (ties go up), and so does its center.
         for l in o.leaves() {
@@ -446,9 +447,9 @@ fn build_is_deterministic_across_thread_counts() {
     // The big sphere has lists longer than the parallel chunk size.
     for s in [sphere(160, 60), random_triangles()] {
         for params in [OctreeParams::default(), SMALL] {
-            let a = one.install(|| Octree::build(&s, params));
-            let b = two.install(|| Octree::build(&s, params));
-            let c = two.install(|| Octree::build(&s, params));
+            let a = one.install(|| Octree::build(&s, params).expect("valid octree parameters"));
+            let b = two.install(|| Octree::build(&s, params).expect("valid octree parameters"));
+            let c = two.install(|| Octree::build(&s, params).expect("valid octree parameters"));
             assert!(a == b && b == c, "{}: builds differ", s.name);
         }
     }
@@ -525,7 +526,7 @@ fn neighbours_match_the_integer_reference_in_all_26_directions() {
     let mut kinds = [0usize; 3];
     for s in scenes() {
         for params in param_sets(&s) {
-            let o = Octree::build(&s, params);
+            let o = Octree::build(&s, params).expect("valid octree parameters");
             let grid = Grid::new(&o);
             let cells: HashMap<Cell, NodeId> = o.nodes().map(|n| (grid.cell(&o.node_bounds(n)), n)).collect();
             assert_eq!(cells.len(), o.node_count(), "{}: two nodes with one box", s.name);
@@ -562,7 +563,7 @@ fn neighbours_match_the_integer_reference_in_all_26_directions() {
 fn leaves_on_faces_match_the_integer_reference() {
     for s in scenes() {
         for params in param_sets(&s) {
-            let o = Octree::build(&s, params);
+            let o = Octree::build(&s, params).expect("valid octree parameters");
             let grid = Grid::new(&o);
             let cells: HashMap<Cell, NodeId> = o.nodes().map(|n| (grid.cell(&o.node_bounds(n)), n)).collect();
             // want[node][face]: every leaf under the node touching that face, by ascending id; index 6
@@ -619,7 +620,7 @@ fn hand_run_timing() {
     use std::time::Instant;
     let s = if std::env::var("SMALL_SPHERE").is_ok() { sphere(40, 30) } else { sphere(1000, 300) };
     let t = Instant::now();
-    let o = Octree::build(&s, OctreeParams::default());
+    let o = Octree::build(&s, OctreeParams::default()).expect("valid octree parameters");
     let build = t.elapsed();
     let t = Instant::now();
     let report = o.validate(&s);

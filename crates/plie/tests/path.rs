@@ -43,7 +43,7 @@ fn trace(scene: &Scene, camera: &Camera, size: u32, n: u32, path: PathSettings, 
     let settings = RenderSettings { width: size, height: size, eye_rays: 1, shadow_rays: n, seed: 7 };
     let bvh = Bvh::build(scene);
     let params = PlieParams { max_triangles: 4, ..PlieParams::default() };
-    let octree = Octree::build(scene, params.octree());
+    let octree = Octree::build(scene, params.octree()).expect("valid octree parameters");
     let plie = mode.needs_plie().then(|| plie::construct::build(scene, &octree, params, &NoProgress).0);
     let vis = for_mode(mode, scene, &bvh, &octree, plie.as_ref()).unwrap();
     let oc = mode.needs_plie().then_some(&octree);
@@ -101,7 +101,7 @@ fn depth_two_equals_direct_light_in_expectation() {
     let traced = trace(&scene, &camera, size, 4, path, Mode::Bvh);
     let settings = RenderSettings { width: size, height: size, eye_rays: 8, shadow_rays: 16, seed: 3 };
     let bvh = Bvh::build(&scene);
-    let octree = Octree::build(&scene, Default::default());
+    let octree = Octree::build(&scene, Default::default()).expect("valid octree parameters");
     let vis = for_mode(Mode::Bvh, &scene, &bvh, &octree, None).unwrap();
     let direct = render(&scene, &camera, &settings, &bvh, None, vis.as_ref(), &NoProgress).unwrap();
     // Per-pixel differences: their mean is zero in expectation; compare it with its standard error.

@@ -11,7 +11,7 @@ use plie::visibility::{bvh::Bvh, for_mode, Mode};
 use plie::Scene;
 
 fn built(scene: &Scene, params: PlieParams) -> (Octree, plie::lie::Plie) {
-    let octree = Octree::build(scene, params.octree());
+    let octree = Octree::build(scene, params.octree()).expect("valid octree parameters");
     let (p, _) = plie::construct::build(scene, &octree, params, &NoProgress);
     (octree, p)
 }
@@ -122,7 +122,12 @@ fn refined_round_trip_and_refinement_mismatch() {
     let dir = tempfile::tempdir().unwrap();
     let scene = plie::scene::builtin::load("cornell-cube-5").unwrap();
     let params = PlieParams { refine: RefineParams::thesis_umbra(), ..PlieParams::thesis() };
-    let b = plie::construct::build_refined(&scene, Octree::build(&scene, params.octree()), params, &NoProgress);
+    let b = plie::construct::build_refined(
+        &scene,
+        Octree::build(&scene, params.octree()).expect("valid octree parameters"),
+        params,
+        &NoProgress,
+    );
     assert!(!b.plie.splits.is_empty());
     let path = dir.path().join("refined.plie");
     save_plie(&path, &scene, &b.octree, &b.plie).unwrap();

@@ -14,7 +14,7 @@ mod support;
 
 use glam::{Vec2, Vec3};
 use plie::construct::{build_traced, Built};
-use plie::lie::{Plie, PlieParams};
+use plie::lie::{Plie, PlieParams, Propagation};
 use plie::octree::{Dir, LeafId, Octree};
 use plie::render::{render, NoProgress, RenderSettings};
 use plie::visibility::lie::exit_face;
@@ -109,9 +109,9 @@ fn check_same_records(scene: &Scene, octree: &Octree, with: &Built, without: &Pl
 /// Both checks on one scene; returns (records propagated, segments checked).
 fn check_scene(scene: &Scene, max_triangles: usize, samples: usize) -> (usize, usize) {
     let params = PlieParams { max_triangles, ..PlieParams::default() };
-    let octree = Octree::build(scene, params.octree());
+    let octree = Octree::build(scene, params.octree()).expect("valid octree parameters");
     let with = build(scene, &octree, params);
-    let without = build(scene, &octree, PlieParams { propagation: false, ..params });
+    let without = build(scene, &octree, PlieParams { propagation: Propagation::Off, ..params });
     assert!(without.propagated.is_empty());
     assert_eq!(with.stats.records_removed_propagation, with.propagated.len());
     check_same_records(scene, &octree, &with, &without.plie);
@@ -140,7 +140,7 @@ fn propagated_records_are_dark_and_the_rest_unchanged_on_shared_scenes() {
             // Soundness only, at the thesis' 200 per leaf: a second build without propagation would
             // take minutes.
             let params = PlieParams::thesis();
-            let octree = Octree::build(&scene, params.octree());
+            let octree = Octree::build(&scene, params.octree()).expect("valid octree parameters");
             let with = build(&scene, &octree, params);
             let c = check_sound(&scene, &octree, &with, 16);
             eprintln!(
@@ -166,7 +166,12 @@ fn propagated_records_of_refined_p_lies_are_dark() {
         let scene = plie::scene::builtin::load(name).unwrap();
         let params =
             PlieParams { refine: plie::construct::refine::RefineParams::thesis_umbra(), ..PlieParams::thesis() };
-        let b = plie::construct::build_refined(&scene, Octree::build(&scene, params.octree()), params, &NoProgress);
+        let b = plie::construct::build_refined(
+            &scene,
+            Octree::build(&scene, params.octree()).expect("valid octree parameters"),
+            params,
+            &NoProgress,
+        );
         assert!(b.stats.refine_rounds > 0);
         assert_eq!(b.stats.records_removed_propagation, b.propagated.len());
         let c = check_sound(&scene, &b.octree, &b, 16);
@@ -180,7 +185,7 @@ fn propagated_records_of_refined_p_lies_are_dark() {
 fn propagation_does_not_depend_on_the_thread_count() {
     let scene = plie::scene::builtin::load("huis-a").unwrap();
     let params = PlieParams { max_triangles: 24, ..PlieParams::thesis() };
-    let octree = Octree::build(&scene, params.octree());
+    let octree = Octree::build(&scene, params.octree()).expect("valid octree parameters");
     let on = |threads| {
         let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
         pool.install(|| build(&scene, &octree, params))
@@ -200,7 +205,7 @@ fn images_with_many_propagated_records_match_brute_force() {
     for name in ["huis-a", "huis-c", "boot"] {
         let scene = plie::scene::builtin::load(name).unwrap();
         let params = PlieParams { max_triangles: 24, ..PlieParams::default() };
-        let octree = Octree::build(&scene, params.octree());
+        let octree = Octree::build(&scene, params.octree()).expect("valid octree parameters");
         let built = build(&scene, &octree, params);
         assert!(built.propagated.len() > 100, "{name}: {}", built.propagated.len());
         let bvh = plie::visibility::bvh::Bvh::build(&scene);

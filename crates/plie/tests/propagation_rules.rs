@@ -74,7 +74,7 @@ fn config(coarse_top: bool, c: [i32; 3], x: (f32, f32), y: f32, z: (f32, f32)) -
     let q = |x: f32, z: f32| Vec3::new(x, -0.99 * R, z) - Vec3::new(0.99 * R, 0.0, 0.99 * R);
     b.light("probe", &[q(0.0, 0.0), q(0.0, 0.1), q(0.1, 0.1), q(0.1, 0.0)], Vec3::ONE);
     let bare = b.build().unwrap();
-    let o = Octree::build(&bare, params());
+    let o = Octree::build(&bare, params()).expect("valid octree parameters");
     let cell = o.leaf_bounds(leaf_at(&o, c));
     let s = cell.size().x;
     let p = |u: f32, v: f32, w: f32| cell.min + Vec3::new(u, v, w) * s;
@@ -83,7 +83,7 @@ fn config(coarse_top: bool, c: [i32; 3], x: (f32, f32), y: f32, z: (f32, f32)) -
     // Counter-clockwise seen from below: emits down.
     b.light("l", &[p(x.0, y, z.0), p(x.1, y, z.0), p(x.1, y, z.1), p(x.0, y, z.1)], Vec3::ONE);
     let scene = b.build().unwrap();
-    let octree = Octree::build(&scene, params());
+    let octree = Octree::build(&scene, params()).expect("valid octree parameters");
     assert_eq!(octree.leaf_count(), o.leaf_count(), "the light must not change the grid");
     let c = leaf_at(&octree, c);
     assert_eq!(octree.leaf_bounds(c), cell);

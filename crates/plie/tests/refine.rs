@@ -11,7 +11,7 @@ mod support;
 use glam::Vec3;
 use plie::construct::refine::{MaxBlockers, RefineParams};
 use plie::construct::{build, build_refined};
-use plie::lie::PlieParams;
+use plie::lie::{Grids, PlieParams, Propagation};
 use plie::octree::Octree;
 use plie::render::{render, NoProgress, RenderSettings};
 use plie::visibility::{Mode, QueryCtx};
@@ -98,8 +98,8 @@ fn refined_p_lies_by_blockers_are_exact() {
 fn reused_records_equal_a_build_from_scratch() {
     for name in ["cornell-cube-1", "cornell-cube-4", "dragon", "huis-c"] {
         let scene = plie::scene::builtin::load(name).unwrap();
-        let params = PlieParams { propagation: false, grids: true, ..refined_params() };
-        let octree = Octree::build(&scene, params.octree());
+        let params = PlieParams { propagation: Propagation::Off, grids: Grids::Build, ..refined_params() };
+        let octree = Octree::build(&scene, params.octree()).expect("valid octree parameters");
         let refined = build_refined(&scene, octree, params, &NoProgress);
         assert!(refined.stats.refine_rounds > 0, "{name}: nothing split");
         let (fresh, stats) =
@@ -121,8 +121,9 @@ fn refinement_does_not_depend_on_the_thread_count() {
         let run = |threads| {
             let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
             pool.install(|| {
-                let octree = Octree::build(&scene, PlieParams::thesis().octree());
-                let b = build_refined(&scene, octree, PlieParams { grids: true, ..refined_params() }, &NoProgress);
+                let octree = Octree::build(&scene, PlieParams::thesis().octree()).expect("valid octree parameters");
+                let b =
+                    build_refined(&scene, octree, PlieParams { grids: Grids::Build, ..refined_params() }, &NoProgress);
                 (b.octree, b.plie, b.propagated)
             })
         };
@@ -138,7 +139,7 @@ fn refinement_does_not_depend_on_the_thread_count() {
 #[test]
 fn max_split_depth_bounds_a_chain_that_would_never_stop() {
     let scene = plie::scene::builtin::load("cornell-cube-1").unwrap();
-    let base = Octree::build(&scene, PlieParams::thesis().octree());
+    let base = Octree::build(&scene, PlieParams::thesis().octree()).expect("valid octree parameters");
     assert!(base.leaves().all(|l| base.leaf_depth(l) == 1));
     for k in 0..=3u32 {
         let refine = RefineParams { blockers: Some(MaxBlockers::Fixed(0)), max_split_depth: k, ..RefineParams::none() };
@@ -168,7 +169,7 @@ fn max_split_depth_bounds_a_chain_that_would_never_stop() {
 #[test]
 fn umbra_refinement_removes_more_dark_records() {
     let scene = plie::scene::builtin::load("cornell-cube-1").unwrap();
-    let octree = Octree::build(&scene, PlieParams::thesis().octree());
+    let octree = Octree::build(&scene, PlieParams::thesis().octree()).expect("valid octree parameters");
     let (_, plain) = build(&scene, &octree, PlieParams::thesis(), &NoProgress);
     let b = build_refined(&scene, octree, refined_params(), &NoProgress);
     assert!(b.stats.refine_splits.get("umbra_full").copied().unwrap_or(0) > 0, "{:?}", b.stats.refine_splits);

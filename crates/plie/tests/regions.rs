@@ -9,7 +9,7 @@ use plie::construct::grid::{cell_box, face_axes};
 use plie::construct::regions::{face_regions, in_triangles, FaceFrame, Tri2, UNITS};
 use plie::construct::shaft::Shaft;
 use plie::geometry::RayTest;
-use plie::lie::{Cell, Plie, PlieParams};
+use plie::lie::{Cell, Plie, PlieParams, Propagation, Regions};
 use plie::octree::{Dir, LeafId, Octree};
 use plie::render::NoProgress;
 use plie::visibility::query::SEGMENT_EPS;
@@ -37,7 +37,7 @@ fn point_in(t: &Tri2, rng: &mut TestRng) -> DVec2 {
 }
 
 fn build(scene: &Scene, params: PlieParams) -> (Octree, Plie) {
-    let octree = Octree::build(scene, params.octree());
+    let octree = Octree::build(scene, params.octree()).expect("valid octree parameters");
     let (plie, _) = plie::construct::build(scene, &octree, params, &NoProgress);
     (octree, plie)
 }
@@ -47,9 +47,9 @@ fn build(scene: &Scene, params: PlieParams) -> (Octree, Plie) {
 fn check_regions(scene: &Scene, max_triangles: usize, samples: usize) -> (usize, usize, usize) {
     // Without propagation: every removed record is then one the regions found dark (tests/propagation.rs
     // checks the records propagation deletes).
-    let params = PlieParams { max_triangles, propagation: false, ..PlieParams::default() };
+    let params = PlieParams { max_triangles, propagation: Propagation::Off, ..PlieParams::default() };
     let (octree, plie) = build(scene, params);
-    let (_, bare) = build(scene, PlieParams { regions: false, ..params });
+    let (_, bare) = build(scene, PlieParams { regions: Regions::Skip, ..params });
     let mut rng = TestRng(0x5eed ^ scene.triangles.len() as u64);
     let (mut umbra_pts, mut lit_pts, mut removed) = (0, 0, 0);
     for r in &bare.records {
@@ -153,7 +153,7 @@ fn cornell_cube_1_right_bottom_front_cell_has_every_lit_face_in_umbra() {
     for name in ["cornell-cube-1", "cornell-cube-5"] {
         let scene = plie::scene::builtin::load(name).unwrap();
         let (octree, plie) = build(&scene, PlieParams::default());
-        let (_, bare) = build(&scene, PlieParams { regions: false, ..PlieParams::default() });
+        let (_, bare) = build(&scene, PlieParams { regions: Regions::Skip, ..PlieParams::default() });
         let c = octree.root_bounds().center();
         let leaf = octree.locate(c + Vec3::new(1.0, -1.0, 1.0)).unwrap();
         let b = octree.leaf_bounds(leaf);

@@ -406,7 +406,7 @@ fn run_round(
     let lights = scene.lights.len();
     let abs_scale = abs_scale(octree);
     let tols = Tolerances::new(tol, abs_scale);
-    let propagate = params.propagation && params.regions;
+    let propagate = params.propagates();
     let order = propagation::task_order(scene, octree, propagate);
     let mut states = FaceStates::new(scene, octree, tol);
     let mut propagator = Propagator::new(scene, octree, tols);
@@ -436,7 +436,7 @@ fn run_round(
     let deleted: Vec<AtomicBool> = (0..states.len()).map(|_| AtomicBool::new(false)).collect();
     // The budget counts the lists of the records carried over from the previous round too.
     let used = tasks.iter().flat_map(|t| t.records.iter().flatten()).map(PendingRecord::list_bytes).sum();
-    let budget = Budget { limit: limits.list_bytes, used, over: 0, grids: params.grids };
+    let budget = Budget { limit: limits.list_bytes, used, over: 0, grids: params.has_grids() };
     let mut commits = Commits { states, propagator, tasks, lights, propagate, seconds: 0.0, wasted: 0, budget };
     let cancelled = AtomicBool::new(false);
     let scratches: Vec<Mutex<GatherScratch>> = (0..rayon::current_num_threads().max(1))
@@ -622,7 +622,7 @@ fn flatten(
     stats.region_triangles = plie.region_tris.len();
     stats.region_bytes = plie.region_tris.len() * std::mem::size_of::<regions::Tri2>()
         + plie.regions.len() * std::mem::size_of::<RecordRegions>();
-    if params.regions && stats.records > 0 {
+    if params.has_regions() && stats.records > 0 {
         stats.umbra_fraction_mean = umbra_sum / stats.records as f64;
         stats.penumbra_fraction_mean = penumbra_sum / stats.records as f64;
     }
@@ -692,17 +692,17 @@ fn face_record(
     let gathered = gather_blockers(scene, octree, &shaft, light_id, cap, scratch, &mut blockers);
     // Capped: `blockers` is a subset, whose umbra is a subset of the true umbra (still sound); its
     // penumbra is not needed.
-    let regions = params.regions.then(|| {
+    let regions = params.has_regions().then(|| {
         let f = if gathered.capped { regions::face_umbra } else { regions::face_regions };
         f(scene, face, &b, light, &blockers, &shaft, tol, abs_scale)
     });
     let (record, state) = if let Some(reg) = regions.as_ref().filter(|r| r.full_umbra) {
         (None, FaceState::Dark { budget: propagation::dark_budget(face, &b, light, reg, tols) })
     } else if gathered.capped {
-        (Some(PendingRecord::scene(regions, params.grids)), FaceState::Kept)
+        (Some(PendingRecord::scene(regions, params.has_grids())), FaceState::Kept)
     } else {
         let has_umbra = regions.as_ref().is_some_and(|r| !r.umbra.is_empty());
-        let mut grid = if params.grids {
+        let mut grid = if params.has_grids() {
             let min_res = if has_umbra { grid::UMBRA_MIN_RES } else { 0 };
             grid::face_grid(scene, face, &b, light, &blockers, tol, min_res)
         } else {

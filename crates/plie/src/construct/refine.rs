@@ -249,7 +249,7 @@ mod tests {
     /// What the chain sees of the lower `+x +z` leaf: its kept records, computed as the builder does.
     fn decide_leaf(blockers: &[[f32; 4]], p: &RefineParams) -> Option<Criterion> {
         let scene = plate_scene(blockers);
-        let octree = Octree::build(&scene, OctreeParams::thesis());
+        let octree = Octree::build(&scene, OctreeParams::thesis()).expect("valid octree parameters");
         let leaf = octree.locate(Vec3::new(0.5, 0.5, 0.5)).unwrap();
         let top = octree.leaf_bounds(leaf);
         assert!((top.max.y - 1.0).abs() < 1e-2 && top.min.x.abs() < 1e-2 && (top.max.x - 1.0).abs() < 1e-2);

@@ -103,7 +103,7 @@ impl Inspector<'_> {
             scene: scene.name.clone(),
             octree_leaves: octree.leaf_count(),
             lights: scene.lights.len(),
-            regions: plie.params.regions,
+            regions: plie.params.has_regions(),
             records: 0,
             removed: 0,
             cannot_see_light: 0,
@@ -120,7 +120,7 @@ impl Inspector<'_> {
                             out.records += 1;
                             let fractions = plie
                                 .params
-                                .regions
+                                .has_regions()
                                 .then(|| (area_fraction(plie.umbra_of(r)), area_fraction(plie.penumbra_of(r))));
                             (Some(plie.records[r].blockers_len), fractions.map(|f| f.0), fractions.map(|f| f.1))
                         }

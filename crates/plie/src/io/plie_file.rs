@@ -24,8 +24,8 @@ use serde::{Deserialize, Serialize};
 use xxhash_rust::xxh3::{xxh3_64, Xxh3};
 
 use super::atomic::write_atomic;
-use crate::error::{Error, Result};
-use crate::lie::{Plie, PlieParams, RecordKind, CHUNKED_MIN, NO_RECORD, SCENE_CELL, UMBRA_CELL};
+use crate::error::{Error, PlieFileError, Result};
+use crate::lie::{Plie, PlieParams};
 use crate::octree::Octree;
 use crate::scene::Scene;
 
@@ -121,57 +121,60 @@ pub fn save_plie(path: &Path, scene: &Scene, octree: &Octree, plie: &Plie) -> Re
 /// Loads a `.plie` file for `scene`: checks format, version, integrity, that it was built for this
 /// scene (and, if `expect` is given, on the same octree parameters; whether it has face grids does
 /// not matter, modes use them when present), rebuilds the octree and checks that it is the one the
-/// P-LIE was built on. Returns the octree and the P-LIE.
+/// P-LIE was built on. Returns the octree and the P-LIE. Every problem with the file is an
+/// [`Error::PlieFile`].
 pub fn load_plie(path: &Path, scene: &Scene, expect: Option<PlieParams>) -> Result<(Octree, Plie)> {
     let bytes = super::input::read_bounded(path, super::input::MAX_INPUT_BYTES)?;
-    let bad = |m: String| Error::Parse { path: path.to_path_buf(), line: None, message: m };
+    read_plie(&bytes, scene, expect).map_err(|problem| Error::PlieFile { path: path.to_path_buf(), problem })
+}
+
+/// [`load_plie`] of the file's bytes.
+fn read_plie(bytes: &[u8], scene: &Scene, expect: Option<PlieParams>) -> Result<(Octree, Plie), PlieFileError> {
     if bytes.len() < 8 || bytes[..8] != MAGIC {
-        return Err(bad("not a .plie file (wrong magic bytes)".into()));
+        return Err(PlieFileError::BadMagic);
     }
     if bytes.len() < HEADER {
-        return Err(bad("truncated .plie file (incomplete header)".into()));
+        return Err(PlieFileError::TruncatedHeader);
     }
     let version = u32::from_le_bytes(bytes[8..12].try_into().expect("4 bytes"));
     if version != FORMAT_VERSION {
-        return Err(bad(format!(
-            "made with .plie format version {version}; this plie reads version {FORMAT_VERSION}: rebuild it with `plie build`"
-        )));
+        return Err(PlieFileError::Version { found: version, supported: FORMAT_VERSION });
     }
     let len = u64::from_le_bytes(bytes[12..20].try_into().expect("8 bytes"));
     let sum = u64::from_le_bytes(bytes[20..28].try_into().expect("8 bytes"));
     let payload = &bytes[HEADER..];
     if (payload.len() as u64) < len {
-        return Err(bad(format!("truncated .plie file ({} of {len} payload bytes)", payload.len())));
+        return Err(PlieFileError::Truncated { have: payload.len() as u64, expected: len });
     }
     if payload.len() as u64 != len {
-        return Err(bad(format!("corrupted .plie file ({} bytes after the payload)", payload.len() as u64 - len)));
+        return Err(PlieFileError::TrailingBytes { extra: payload.len() as u64 - len });
     }
     if xxh3_64(payload) != sum {
-        return Err(bad("corrupted .plie file (checksum mismatch)".into()));
+        return Err(PlieFileError::Checksum);
     }
-    let body: FileBody =
-        postcard::from_bytes(payload).map_err(|_| {
-        bad("corrupted .plie file: the checksum matches but the content is not a P-LIE (written by another program or altered): rebuild it with `plie build`".into())
-    })?;
+    let body: FileBody = postcard::from_bytes(payload).map_err(|_| PlieFileError::Undecodable)?;
     if body.scene_fingerprint != scene_fingerprint(scene) {
-        return Err(bad(format!("was built for another scene, not '{}' (rebuild it with `plie build`)", scene.name)));
+        return Err(PlieFileError::OtherScene { scene: scene.name.clone() });
     }
     if let Some(p) = expect {
         if p.octree() != body.params.octree() || p.refine != body.params.refine {
-            let (file, asked) = (describe_params(&body.params), describe_params(&p));
-            return Err(bad(format!("was built with other parameters ({file}) than asked for ({asked})")));
+            return Err(PlieFileError::OtherParameters {
+                file: describe_params(&body.params),
+                asked: describe_params(&p),
+            });
         }
     }
-    body.params.octree().validate().map_err(|e| bad(format!("invalid parameters in file: {e}")))?;
-    body.params.refine.validate(body.params.regions).map_err(|e| bad(format!("invalid parameters in file: {e}")))?;
-    let mut octree = Octree::build(scene, body.params.octree());
+    let invalid = |e: Error| PlieFileError::InvalidParameters(e.to_string());
+    body.params.octree().validate().map_err(invalid)?;
+    body.params.refine.validate(body.params.has_regions()).map_err(invalid)?;
+    let mut octree = Octree::build_valid(scene, body.params.octree());
     for round in &body.plie.splits {
-        octree = octree.split_nodes(scene, round).map_err(|e| bad(format!("inconsistent .plie file: {e}")))?;
+        octree = octree.split_nodes(scene, round).map_err(|e| PlieFileError::Inconsistent(e.to_string()))?;
     }
     if octree_fingerprint(&octree) != body.octree_fingerprint {
-        return Err(bad("its octree differs from the one this plie builds for the scene: rebuild it".into()));
+        return Err(PlieFileError::OtherOctree);
     }
-    check_structure(&body.plie, scene, &octree).map_err(|m| bad(format!("inconsistent .plie file: {m}")))?;
+    body.plie.validate(scene, &octree).map_err(PlieFileError::Inconsistent)?;
     Ok((octree, body.plie))
 }
 
@@ -198,79 +201,4 @@ fn describe_params(p: &PlieParams) -> String {
         None => {}
     }
     s
-}
-
-/// Every index in range, every record where the index says it is.
-fn check_structure(p: &Plie, scene: &Scene, octree: &Octree) -> std::result::Result<(), String> {
-    if p.leaves as usize != octree.leaf_count() || p.lights as usize != scene.lights.len() {
-        return Err(format!(
-            "{} leaves and {} lights, expected {} and {}",
-            p.leaves,
-            p.lights,
-            octree.leaf_count(),
-            scene.lights.len()
-        ));
-    }
-    if p.record_index.len() != p.leaves as usize * 6 * p.lights as usize {
-        return Err("record table has the wrong size".into());
-    }
-    for (i, &r) in p.record_index.iter().enumerate() {
-        if r == NO_RECORD {
-            continue;
-        }
-        let rec = p.records.get(r as usize).ok_or_else(|| format!("record index {r} out of range"))?;
-        let at = p.slot(rec.leaf, rec.face, rec.light);
-        if at != i {
-            return Err(format!("record {r} is filed under the wrong (leaf, face, light)"));
-        }
-    }
-    for (i, rec) in p.records.iter().enumerate() {
-        let end = rec.blockers_start as u64 + rec.blockers_len as u64;
-        if end > p.blockers.len() as u64 {
-            return Err(format!("record {i}: blocker range out of bounds"));
-        }
-    }
-    // Short lists are promised in ascending id order (long ones in Morton order, see `CHUNKED_MIN`).
-    let ascending = |l: &[crate::scene::TriId]| l.len() >= CHUNKED_MIN || l.windows(2).all(|w| w[0].0 <= w[1].0);
-    if let Some(i) = p.records.iter().position(|r| !ascending(p.blockers_of(r))) {
-        return Err(format!("record {i}: blocker list out of order"));
-    }
-    let cell_list = |&(start, len): &(u32, u32)| p.cell_blockers.get(start as usize..start as usize + len as usize);
-    if p.cells.iter().filter(|&&c| c != UMBRA_CELL).any(|c| cell_list(c).is_some_and(|l| !ascending(l))) {
-        return Err("grid cell blocker list out of order".into());
-    }
-    if let Some(t) = p.blockers.iter().chain(&p.cell_blockers).find(|t| t.idx() >= scene.triangles.len()) {
-        return Err(format!("blocker triangle {} out of range", t.0));
-    }
-    if p.grids.len() != p.records.len() {
-        return Err("grid table has the wrong size".into());
-    }
-    for (i, g) in p.grids.iter().enumerate() {
-        if g.res > 64 || g.cells_start as u64 + (g.res as u64 * g.res as u64) > p.cells.len() as u64 {
-            return Err(format!("record {i}: face grid out of bounds"));
-        }
-    }
-    if p.records.iter().any(|r| r.kind == RecordKind::Scene && r.blockers_len != 0) {
-        return Err("a record answered by the scene holds blockers".into());
-    }
-    if p.cells
-        .iter()
-        .any(|&c| c != UMBRA_CELL && c != SCENE_CELL && c.0 as u64 + c.1 as u64 > p.cell_blockers.len() as u64)
-    {
-        return Err("grid cell list out of bounds".into());
-    }
-    if p.regions.len() != p.records.len() {
-        return Err("region table has the wrong size".into());
-    }
-    let n = p.region_tris.len() as u64;
-    for (i, r) in p.regions.iter().enumerate() {
-        if r.umbra_start as u64 + r.umbra_len as u64 > n || r.penumbra_start as u64 + r.penumbra_len as u64 > n {
-            return Err(format!("record {i}: region triangles out of bounds"));
-        }
-    }
-    let units = crate::construct::regions::UNITS as i32;
-    if p.region_tris.iter().flatten().flatten().any(|&c| c.abs() > 4 * units) {
-        return Err("region triangle out of range".into());
-    }
-    Ok(())
 }

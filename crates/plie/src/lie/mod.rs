@@ -14,6 +14,8 @@
 //! Its umbra, computed from a subset of its blockers, is a subset of the true umbra and still answers
 //! "occluded"; its penumbra and its lit cells are unknown, so it stores none.
 
+mod validate;
+
 use serde::{Deserialize, Serialize};
 
 use crate::construct::refine::RefineParams;
@@ -44,15 +46,15 @@ pub struct PlieParams {
     pub max_triangles: usize,
     /// Octree: maximum depth.
     pub max_depth: u32,
-    /// Build face grids (per-cell blocker lists, our addition; used by mode `grid`).
-    pub grids: bool,
-    /// Compute umbra and penumbra (SPEC §4.5) and remove fully dark records (§4.6). The thesis' Table
-    /// 8.4 measured construction without them.
-    pub regions: bool,
-    /// Propagate umbra to neighbouring cells (SPEC §4.7, thesis chapter 6): delete the records of
-    /// faces proven dark by a fully dark neighbour without computing their blockers. Only speeds up
-    /// construction; needs `regions` (without them no face is known to be dark).
-    pub propagation: bool,
+    /// Whether to build face grids (per-cell blocker lists, our addition; used by mode `grid`).
+    pub grids: Grids,
+    /// Whether to compute umbra and penumbra (SPEC §4.5) and remove fully dark records (§4.6). The
+    /// thesis' Table 8.4 measured construction without them.
+    pub regions: Regions,
+    /// Whether to propagate umbra to neighbouring cells (SPEC §4.7, thesis chapter 6): delete the
+    /// records of faces proven dark by a fully dark neighbour without computing their blockers. Only
+    /// speeds up construction; needs regions (without them no face is known to be dark).
+    pub propagation: Propagation,
     /// Refinement of the octree after the records are known (SPEC §4.8); off by default, as in the
     /// thesis' test 1.
     pub refine: RefineParams,
@@ -72,9 +74,9 @@ impl PlieParams {
         PlieParams {
             max_triangles: o.max_triangles,
             max_depth: o.max_depth,
-            grids: false,
-            regions: true,
-            propagation: true,
+            grids: Grids::Skip,
+            regions: Regions::Compute,
+            propagation: Propagation::On,
             refine: RefineParams::none(),
             blocker_cap: None,
         }
@@ -86,6 +88,28 @@ impl PlieParams {
         PlieParams { blocker_cap: Some(DEFAULT_BLOCKER_CAP), ..self }
     }
 
+    /// Checks the parameters: the octree's ([`crate::octree::OctreeParams::validate`]) and the
+    /// refinement's, which must agree with the rest (refining by umbra needs regions).
+    pub fn validate(&self) -> crate::Result<()> {
+        self.octree().validate()?;
+        self.refine.validate(self.has_regions())
+    }
+
+    /// True if face grids are built ([`Grids::Build`]).
+    pub fn has_grids(&self) -> bool {
+        self.grids == Grids::Build
+    }
+
+    /// True if umbra and penumbra are computed ([`Regions::Compute`]).
+    pub fn has_regions(&self) -> bool {
+        self.regions == Regions::Compute
+    }
+
+    /// True if umbra is propagated: [`Propagation::On`] and regions computed.
+    pub fn propagates(&self) -> bool {
+        self.propagation == Propagation::On && self.has_regions()
+    }
+
     /// The octree part of the parameters.
     pub fn octree(&self) -> crate::octree::OctreeParams {
         crate::octree::OctreeParams { max_triangles: self.max_triangles, max_depth: self.max_depth }
@@ -95,8 +119,38 @@ impl PlieParams {
 impl Default for PlieParams {
     /// The thesis' parameters (with umbra and penumbra) plus face grids.
     fn default() -> PlieParams {
-        PlieParams { grids: true, ..PlieParams::thesis() }
+        PlieParams { grids: Grids::Build, ..PlieParams::thesis() }
     }
+}
+
+/// Whether the construction builds face grids ([`PlieParams::grids`]). Stored in `.plie` files as
+/// the boolean it replaced (`Skip` = 0, `Build` = 1).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub enum Grids {
+    /// No face grids: mode `grid` answers as `penumbra` (or `lie`).
+    Skip,
+    /// A face grid per record.
+    Build,
+}
+
+/// Whether the construction computes umbra and penumbra ([`PlieParams::regions`]). Stored as the
+/// boolean it replaced (`Skip` = 0, `Compute` = 1).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub enum Regions {
+    /// Blocker lists only (modes `umbra` and `penumbra` refuse such a P-LIE).
+    Skip,
+    /// Umbra and penumbra per record, and removal of fully dark records.
+    Compute,
+}
+
+/// Whether the construction propagates umbra ([`PlieParams::propagation`]). Stored as the boolean
+/// it replaced (`Off` = 0, `On` = 1).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub enum Propagation {
+    /// Every face's blockers are computed.
+    Off,
+    /// Faces proven dark by a dark neighbour lose their record without being computed.
+    On,
 }
 
 /// How a record answers the rays through its face beyond its umbra.

@@ -64,14 +64,15 @@ type Split = [Vec<TriId>; 8];
 impl Octree {
     /// Builds the octree of `scene`. Deterministic: the same scene and parameters give the same arrays
     /// for any number of rayon threads.
-    ///
-    /// # Panics
-    /// If `params` fails [`OctreeParams::validate`] (callers taking parameters from users validate
-    /// them first and report the error).
-    pub fn build(scene: &Scene, params: OctreeParams) -> Octree {
-        if let Err(e) = params.validate() {
-            panic!("Octree::build: {e}");
-        }
+    /// Fails with [`crate::Error::InvalidParameter`] if `params` fails [`OctreeParams::validate`].
+    pub fn build(scene: &Scene, params: OctreeParams) -> crate::Result<Octree> {
+        params.validate()?;
+        Ok(Octree::build_valid(scene, params))
+    }
+
+    /// [`Octree::build`] of parameters already validated.
+    pub(crate) fn build_valid(scene: &Scene, params: OctreeParams) -> Octree {
+        debug_assert!(params.validate().is_ok());
         let eps = tolerance(scene);
         let root = root_cube(scene, eps);
         let n = scene.triangles.len();
@@ -242,7 +243,7 @@ mod tests {
     #[test]
     fn root_is_split_even_when_small() {
         let s = two_triangle_scene();
-        let o = Octree::build(&s, OctreeParams::default());
+        let o = Octree::build(&s, OctreeParams::default()).expect("valid octree parameters");
         assert!(matches!(o.nodes[0].kind(), NodeKind::Inner(1)));
         assert_eq!(o.leaf_count(), 8);
         assert_eq!(o.depth(), 1);
@@ -264,7 +265,7 @@ mod tests {
         }
         b.light("light", &[Vec3::new(0.0, 2.0, 0.0), Vec3::new(0.1, 2.0, 0.0), Vec3::new(0.1, 2.0, 0.1)], Vec3::ONE);
         let s = b.build().expect("valid scene");
-        let o = Octree::build(&s, OctreeParams { max_triangles: 4, max_depth: 5 });
+        let o = Octree::build(&s, OctreeParams { max_triangles: 4, max_depth: 5 }).expect("valid octree parameters");
         assert_eq!(o.depth(), 5, "the shared vertex forces splitting to max_depth");
         for l in o.leaves() {
             assert!(o.leaf_triangles(l).len() <= 4 || o.leaf_depth(l) == 5);
@@ -296,7 +297,8 @@ mod tests {
         for copies in [200, 400] {
             let s = coincident_floor(copies);
             assert_eq!(s.triangles.len(), copies + 4);
-            let o = Octree::build(&s, OctreeParams { max_triangles: 200, max_depth: 10 });
+            let o =
+                Octree::build(&s, OctreeParams { max_triangles: 200, max_depth: 10 }).expect("valid octree parameters");
             assert_eq!((o.leaf_count(), o.depth()), (8, 1), "{copies} copies: only the root is split");
             // Every triangle is still in the leaves it overlaps: the rule only stops splitting.
             let mut seen = vec![false; s.triangles.len()];
@@ -307,7 +309,7 @@ mod tests {
         }
         // With a lower limit the distinct triangles are still separated as before.
         let s = coincident_floor(200);
-        let o = Octree::build(&s, OctreeParams { max_triangles: 2, max_depth: 10 });
+        let o = Octree::build(&s, OctreeParams { max_triangles: 2, max_depth: 10 }).expect("valid octree parameters");
         assert!(o.depth() > 1 && o.leaf_count() < 4096, "{} leaves, depth {}", o.leaf_count(), o.depth());
         for l in o.leaves() {
             let tris = o.leaf_triangles(l);
@@ -317,8 +319,8 @@ mod tests {
     }
 
     #[test]
-    #[should_panic(expected = "max_triangles")]
     fn rejects_zero_max_triangles() {
-        Octree::build(&two_triangle_scene(), OctreeParams { max_triangles: 0, max_depth: 3 });
+        let r = Octree::build(&two_triangle_scene(), OctreeParams { max_triangles: 0, max_depth: 3 });
+        assert!(matches!(r, Err(crate::Error::InvalidParameter(m)) if m.contains("max_triangles")));
     }
 }

@@ -53,7 +53,7 @@ mod tests {
         );
         b.light("l", &[Vec3::new(-0.1, 1.0, 0.0), Vec3::new(0.1, 1.0, 0.0), Vec3::new(0.1, 1.0, 0.1)], Vec3::ONE);
         let s = b.build().expect("valid scene");
-        let o = Octree::build(&s, OctreeParams::default());
+        let o = Octree::build(&s, OctreeParams::default()).expect("valid octree parameters");
         let c = o.root_bounds().center();
         let l = o.locate(c).expect("inside");
         assert_eq!(o.leaf_bounds(l).min, c, "the center belongs to the all-upper child");

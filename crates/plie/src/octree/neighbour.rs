@@ -173,7 +173,7 @@ mod tests {
         }
         b.light("l", &[Vec3::new(0.0, 4.0, 0.0), Vec3::new(0.5, 4.0, 0.0), Vec3::new(0.5, 4.0, 0.5)], Vec3::ONE);
         let s = b.build().expect("valid scene");
-        let o = Octree::build(&s, OctreeParams { max_triangles: 4, max_depth: 5 });
+        let o = Octree::build(&s, OctreeParams { max_triangles: 4, max_depth: 5 }).expect("valid octree parameters");
         (s, o)
     }
 

@@ -101,7 +101,7 @@ mod tests {
     #[test]
     fn split_keeps_invariants_and_maps_leaves() {
         let s = builtin::load("cornell-cube-2").unwrap();
-        let o = Octree::build(&s, OctreeParams::thesis());
+        let o = Octree::build(&s, OctreeParams::thesis()).expect("valid octree parameters");
         let split: Vec<_> = o.leaves().filter(|l| l.0 % 3 == 0).collect();
         let (r, origin) = o.split_leaves(&s, &split);
         assert_eq!(r.leaf_count(), o.leaf_count() + 7 * split.len());

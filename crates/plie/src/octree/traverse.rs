@@ -180,7 +180,7 @@ mod tests {
     #[test]
     fn degenerate_directions_and_boundaries() {
         let s = scene();
-        let o = Octree::build(&s, OctreeParams { max_triangles: 4, max_depth: 6 });
+        let o = Octree::build(&s, OctreeParams { max_triangles: 4, max_depth: 6 }).expect("valid octree parameters");
         assert!(o.depth() >= 4);
         for l in o.leaves().step_by(7) {
             let b = o.leaf_bounds(l);
@@ -213,7 +213,7 @@ mod tests {
         assert!(Segment::new(Vec3::new(1.0, 1.0 + 1e-3, 0.5), Vec3::Z, -4.0, 4.0).clip(&b).is_none());
         // The same through the octree: a segment in the plane of a grown leaf box visits that leaf.
         let s = scene();
-        let o = Octree::build(&s, OctreeParams { max_triangles: 4, max_depth: 6 });
+        let o = Octree::build(&s, OctreeParams { max_triangles: 4, max_depth: 6 }).expect("valid octree parameters");
         for l in o.leaves() {
             let g = o.leaf_bounds(l).expanded(o.eps());
             let p = Vec3::new(g.min.x, g.center().y, g.max.z);
@@ -229,7 +229,7 @@ mod tests {
     #[test]
     fn outside_and_empty_ranges() {
         let s = scene();
-        let o = Octree::build(&s, OctreeParams::default());
+        let o = Octree::build(&s, OctreeParams::default()).expect("valid octree parameters");
         let r = o.root_bounds();
         let mut n = 0;
         o.for_each_leaf_on_segment(r.max + Vec3::ONE, Vec3::ONE, 0.0, 1.0, |_| {
@@ -256,7 +256,7 @@ mod tests {
     #[test]
     fn overlapping_box_matches_brute_force() {
         let s = scene();
-        let o = Octree::build(&s, OctreeParams { max_triangles: 4, max_depth: 6 });
+        let o = Octree::build(&s, OctreeParams { max_triangles: 4, max_depth: 6 }).expect("valid octree parameters");
         for l in o.leaves().step_by(5) {
             let q = o.leaf_bounds(l);
             let q = Aabb::new(q.min, q.min + q.size() * 1.7);

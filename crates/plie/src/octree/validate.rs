@@ -363,7 +363,7 @@ mod tests {
     #[test]
     fn a_fresh_octree_is_valid() {
         let s = scene();
-        let o = Octree::build(&s, OctreeParams { max_triangles: 3, max_depth: 6 });
+        let o = Octree::build(&s, OctreeParams { max_triangles: 3, max_depth: 6 }).expect("valid octree parameters");
         let r = o.validate(&s);
         assert!(r.is_ok(), "{r}");
         assert_eq!(r.leaves, o.leaf_count());
@@ -373,7 +373,7 @@ mod tests {
     #[test]
     fn broken_octrees_are_reported() {
         let s = scene();
-        let good = Octree::build(&s, OctreeParams { max_triangles: 3, max_depth: 6 });
+        let good = Octree::build(&s, OctreeParams { max_triangles: 3, max_depth: 6 }).expect("valid octree parameters");
         let busy = good.leaves().find(|&l| good.leaf_triangles(l).len() >= 2).expect("a leaf with triangles");
 
         // A triangle dropped from a leaf (the list shrinks, ranges after it shift).

@@ -3,6 +3,7 @@
 pub mod cpu_time;
 pub mod hit_buffer;
 pub mod path;
+pub mod renderer;
 pub mod sampler;
 pub mod shade;
 
@@ -17,6 +18,7 @@ use crate::scene::{Camera, Scene};
 use crate::visibility::bvh::Bvh;
 use crate::visibility::{QueryStats, Visibility};
 pub use hit_buffer::{Hit, HitBuffer};
+pub use renderer::{Image, Integrator, Renderer, Timing};
 
 /// Reports progress of long work; the library never prints, the CLI shows a bar.
 pub trait Progress: Sync {

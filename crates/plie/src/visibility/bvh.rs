@@ -297,17 +297,15 @@ const CENTRE_CELLS: f64 = (1u32 << 21) as f64;
 /// cell, the union of its boxes, and one per other triangle, in order of first appearance) and their
 /// triangles.
 fn group_crowded_centres(boxes: &[BAabb]) -> Option<(Vec<BAabb>, Groups)> {
-    let span = f64::from(NORMALISED_SIZE + 2.0 * PAD);
+    let per_unit = CENTRE_CELLS / f64::from(NORMALISED_SIZE + 2.0 * PAD);
     // The cell as one number: 21 bits per axis.
     let cell = |b: &BAabb| {
         let c = (b.min + b.max) * 0.5;
-        let [x, y, z] =
-            c.to_array().map(|x| ((f64::from(x + PAD) / span * CENTRE_CELLS).clamp(0.0, CENTRE_CELLS - 1.0)) as u64);
+        let [x, y, z] = c.to_array().map(|x| (f64::from(x + PAD) * per_unit).clamp(0.0, CENTRE_CELLS - 1.0) as u64);
         x << 42 | y << 21 | z
     };
-    let cells: Vec<u64> = boxes.par_iter().map(cell).collect();
     // Whether any cell holds more than the limit: sorted, a crowd is a run (the common case ends here).
-    let mut sorted = cells.clone();
+    let mut sorted: Vec<u64> = boxes.par_iter().map(cell).collect();
     sorted.par_sort_unstable();
     if !sorted.windows(CROWD_LIMIT + 1).any(|w| w[0] == w[CROWD_LIMIT]) {
         return None;
@@ -316,6 +314,7 @@ fn group_crowded_centres(boxes: &[BAabb]) -> Option<(Vec<BAabb>, Groups)> {
     for run in sorted.chunk_by(|a, b| a == b) {
         count.insert(run[0], run.len());
     }
+    let cells: Vec<u64> = boxes.iter().map(cell).collect();
     let mut crowd = std::collections::HashMap::new();
     let mut members: Vec<Vec<u32>> = Vec::new();
     let mut prim_boxes: Vec<BAabb> = Vec::new();

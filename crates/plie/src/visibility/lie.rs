@@ -591,7 +591,7 @@ impl LieVisibility<'_> {
 mod tests {
     use super::*;
     use crate::construct::build;
-    use crate::lie::PlieParams;
+    use crate::lie::{Grids, PlieParams};
     use crate::render::NoProgress;
 
     /// Every triangle of a long list lies in its chunk's box and that in its group's box; shared
@@ -600,8 +600,8 @@ mod tests {
     #[test]
     fn chunk_boxes_cover_their_lists() {
         let scene = crate::scene::builtin::load("huis-a").unwrap();
-        let params = PlieParams { grids: true, ..PlieParams::thesis() };
-        let octree = Octree::build(&scene, params.octree());
+        let params = PlieParams { grids: Grids::Build, ..PlieParams::thesis() };
+        let octree = Octree::build(&scene, params.octree()).expect("valid octree parameters");
         let (plie, _) = build(&scene, &octree, params, &NoProgress);
         let bvh = crate::visibility::bvh::Bvh::build(&scene);
         let vis = LieVisibility::new(&scene, &bvh, &octree, &plie, Mode::Grid);

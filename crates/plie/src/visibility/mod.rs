@@ -14,6 +14,7 @@ pub mod lie;
 pub mod mode;
 pub mod octree;
 pub mod query;
+pub mod shadows;
 
 pub use answer::{Answer, Answers};
 pub use brute::Brute;
@@ -24,6 +25,7 @@ pub use lie::LieVisibility;
 pub use mode::Mode;
 pub use octree::OctreeVisibility;
 pub use query::{blocks, LightAnswers, LightRays, QueryCtx, QueryStats, ShadowRay};
+pub use shadows::Shadows;
 
 /// Test fixture shared by the modes' unit tests: a floor, a wall half above it, and a light above
 /// both. Returns the scene and the floor triangle.
@@ -86,18 +88,30 @@ pub fn for_mode<'a>(
     octree: &'a crate::octree::Octree,
     plie: Option<&'a crate::lie::Plie>,
 ) -> crate::Result<Box<dyn Visibility + 'a>> {
+    make(mode, scene, || bvh, || octree, plie)
+}
+
+/// The visibility method for `mode`; `bvh` and `octree` are asked for only by the modes that use
+/// them. Fails if `mode` needs a P-LIE and none is given, or needs regions the P-LIE lacks.
+pub(crate) fn make<'a>(
+    mode: Mode,
+    scene: &'a crate::Scene,
+    bvh: impl FnOnce() -> &'a bvh::Bvh,
+    octree: impl FnOnce() -> &'a crate::octree::Octree,
+    plie: Option<&'a crate::lie::Plie>,
+) -> crate::Result<Box<dyn Visibility + 'a>> {
     Ok(match mode {
         Mode::Brute => Box::new(Brute::new(scene)),
-        Mode::Octree => Box::new(OctreeVisibility::new(scene, octree)),
-        Mode::Bvh => Box::new(BvhVisibility::new(scene, bvh)),
+        Mode::Octree => Box::new(OctreeVisibility::new(scene, octree())),
+        Mode::Bvh => Box::new(BvhVisibility::new(scene, bvh())),
         Mode::Lie | Mode::Umbra | Mode::Penumbra | Mode::Grid => {
             let plie = plie.ok_or_else(|| crate::Error::InvalidParameter(format!("mode {mode} needs a P-LIE")))?;
-            if mode.needs_regions() && !plie.params.regions {
+            if mode.needs_regions() && !plie.params.has_regions() {
                 return Err(crate::Error::InvalidParameter(format!(
                     "mode {mode} needs umbra and penumbra, but the P-LIE was built without them (--no-regions)"
                 )));
             }
-            Box::new(LieVisibility::new(scene, bvh, octree, plie, mode))
+            Box::new(LieVisibility::new(scene, bvh(), octree(), plie, mode))
         }
         #[cfg(feature = "embree")]
         Mode::Embree => Box::new(NativeEmbree::new(scene)?),

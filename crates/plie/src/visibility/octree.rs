@@ -56,7 +56,7 @@ mod tests {
     #[test]
     fn a_wall_blocks_and_a_gap_does_not() {
         let (s, floor) = crate::visibility::wall_scene();
-        let o = Octree::build(&s, OctreeParams::default());
+        let o = Octree::build(&s, OctreeParams::default()).expect("valid octree parameters");
         let (oct, brute) = (OctreeVisibility::new(&s, &o), Brute::new(&s));
         let mut ctx = QueryCtx::new(s.triangle_count());
         let y = Vec3::new(0.0, 1.0, 0.2);

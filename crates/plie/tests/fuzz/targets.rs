@@ -101,7 +101,7 @@ fn with_files(name: &str, input: &[u8], companions: &[(&str, &[u8])], f: impl Fn
 /// its octree (where coincident triangles once exploded) and BVH (where they once ran too deep).
 fn load_scene_and_build(path: &Path) {
     if let Ok(scene) = load_scene_with(path, LoadOptions::default()) {
-        let _ = Octree::build(&scene, OctreeParams::default());
+        let _ = Octree::build(&scene, OctreeParams::default()).expect("valid octree parameters");
         let _ = Bvh::build(&scene);
     }
 }
@@ -111,8 +111,8 @@ pub fn plie_seed() -> &'static (Scene, Vec<u8>) {
     static SEED: OnceLock<(Scene, Vec<u8>)> = OnceLock::new();
     SEED.get_or_init(|| {
         let scene = plie::scene::builtin::load("cornell-cube-1").expect("built-in scene");
-        let params = plie::lie::PlieParams { grids: true, ..plie::lie::PlieParams::thesis() };
-        let octree = Octree::build(&scene, params.octree());
+        let params = plie::lie::PlieParams { grids: plie::lie::Grids::Build, ..plie::lie::PlieParams::thesis() };
+        let octree = Octree::build(&scene, params.octree()).expect("valid octree parameters");
         let built = plie::construct::build_refined(&scene, octree, params, &plie::render::NoProgress);
         let dir = tempfile::tempdir().expect("a temporary folder");
         let path = dir.path().join("seed.plie");

@@ -97,17 +97,17 @@ pub struct Built {
 impl Built {
     /// Built with `params` plus face grids, refining the octree if `params.refine` asks.
     pub fn refined(scene: &Scene, params: plie::lie::PlieParams) -> Built {
-        let params = plie::lie::PlieParams { grids: true, ..params };
+        let params = plie::lie::PlieParams { grids: plie::lie::Grids::Build, ..params };
         let bvh = plie::visibility::bvh::Bvh::build(scene);
-        let octree = plie::octree::Octree::build(scene, params.octree());
+        let octree = plie::octree::Octree::build(scene, params.octree()).expect("valid octree parameters");
         let b = plie::construct::build_refined(scene, octree, params, &plie::render::NoProgress);
         Built { bvh, octree: b.octree, plie: b.plie }
     }
 
     pub fn new(scene: &Scene, params: plie::lie::PlieParams) -> Built {
-        let params = plie::lie::PlieParams { grids: true, ..params };
+        let params = plie::lie::PlieParams { grids: plie::lie::Grids::Build, ..params };
         let bvh = plie::visibility::bvh::Bvh::build(scene);
-        let octree = plie::octree::Octree::build(scene, params.octree());
+        let octree = plie::octree::Octree::build(scene, params.octree()).expect("valid octree parameters");
         let (plie, _) = plie::construct::build(scene, &octree, params, &plie::render::NoProgress);
         Built { bvh, octree, plie }
     }
