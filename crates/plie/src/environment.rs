@@ -11,7 +11,7 @@ use crate::error::{Error, Result};
 use crate::io::plie_file;
 use crate::lie::{Plie, PlieParams};
 use crate::octree::{Octree, OctreeReport};
-use crate::render::{NoProgress, Progress};
+use crate::progress::{NoProgress, Progress};
 use crate::scene::Scene;
 use crate::visibility::bvh::Bvh;
 use crate::visibility::{Mode, Visibility};

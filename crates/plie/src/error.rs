@@ -50,7 +50,7 @@ pub enum Error {
         /// What is wrong with it.
         problem: PlieFileError,
     },
-    /// The P-LIE construction was interrupted ([`crate::render::Progress::cancelled`]); nothing was
+    /// The P-LIE construction was interrupted ([`crate::progress::Progress::cancelled`]); nothing was
     /// built.
     #[error("interrupted")]
     Interrupted,

@@ -14,7 +14,7 @@ use glam::Vec3;
 
 use crate::lie::Plie;
 use crate::octree::Octree;
-use crate::render::NoProgress;
+use crate::progress::NoProgress;
 use crate::scene::{Scene, TriId};
 use crate::visibility::{Brute, LieVisibility, Mode, QueryCtx, ShadowRay, Visibility};
 

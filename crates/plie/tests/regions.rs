@@ -5,10 +5,11 @@
 mod support;
 
 use glam::{DVec2, Vec2, Vec3};
-use plie::construct::grid::{cell_box, face_axes};
-use plie::construct::regions::{face_regions, in_triangles, FaceFrame, Tri2, UNITS};
+use plie::construct::regions::face_regions;
 use plie::construct::shaft::Shaft;
 use plie::geometry::RayTest;
+use plie::lie::frame::{face_axes, in_triangles, FaceFrame, Tri2, UNITS};
+use plie::lie::grid::cell_box;
 use plie::lie::{Cell, Plie, PlieParams, Propagation, Regions};
 use plie::octree::{Dir, LeafId, Octree};
 use plie::render::NoProgress;

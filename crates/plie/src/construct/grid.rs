@@ -11,9 +11,11 @@
 
 use glam::DVec2;
 
-use super::regions::{FaceRegions, UNITS};
+use super::regions::FaceRegions;
 use super::shaft::Shaft;
 use crate::geometry::Aabb;
+use crate::lie::frame::UNITS;
+pub use crate::lie::grid::{cell_box, cell_of};
 use crate::octree::Dir;
 use crate::scene::{Light, Scene, TriId};
 
@@ -29,29 +31,6 @@ pub const UMBRA_MIN_RES: u32 = 4;
 pub fn resolution(n: usize, min: u32) -> u32 {
     let want = ((n as f64).sqrt() / 2.0).ceil().clamp(min as f64, 8.0) as u32;
     want.next_power_of_two().min(8)
-}
-
-/// The two in-face axes of a face along `axis`: the same `(u, v)` as [`Dir::face_corners`].
-#[inline]
-pub fn face_axes(axis: usize) -> (usize, usize) {
-    ((axis + 1) % 3, (axis + 2) % 3)
-}
-
-/// The box of cell `(i, j)` of face `face` of `cell` (flat along the face's axis).
-pub fn cell_box(face: Dir, cell: &Aabb, g: u32, i: u32, j: u32) -> Aabb {
-    let k = face.axis();
-    let (u, v) = face_axes(k);
-    let w = if face.is_positive() { cell.max[k] } else { cell.min[k] };
-    let (mut lo, mut hi) = (cell.min, cell.max);
-    lo[k] = w;
-    hi[k] = w;
-    let du = (cell.max[u] - cell.min[u]) / g as f32;
-    let dv = (cell.max[v] - cell.min[v]) / g as f32;
-    lo[u] = cell.min[u] + du * i as f32;
-    hi[u] = if i + 1 == g { cell.max[u] } else { cell.min[u] + du * (i + 1) as f32 };
-    lo[v] = cell.min[v] + dv * j as f32;
-    hi[v] = if j + 1 == g { cell.max[v] } else { cell.min[v] + dv * (j + 1) as f32 };
-    Aabb::new(lo, hi)
 }
 
 /// A record's face grid before flattening: the distinct lists, and for each cell (`(i, j)` at
@@ -176,15 +155,4 @@ pub fn umbra_cells(g: u32, regions: &FaceRegions) -> Vec<bool> {
         }
     }
     out
-}
-
-/// The cell of a `g x g` face grid that the face point `p` falls in (clamped to the face).
-#[inline]
-pub fn cell_of(face: Dir, cell: &Aabb, g: u32, p: glam::Vec3) -> usize {
-    let (u, v) = face_axes(face.axis());
-    let fu = (p[u] - cell.min[u]) / (cell.max[u] - cell.min[u]) * g as f32;
-    let fv = (p[v] - cell.min[v]) / (cell.max[v] - cell.min[v]) * g as f32;
-    let i = (fu.max(0.0) as u32).min(g - 1);
-    let j = (fv.max(0.0) as u32).min(g - 1);
-    (j * g + i) as usize
 }

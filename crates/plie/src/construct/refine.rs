@@ -24,122 +24,19 @@
 //! choose where to split; exactness never depends on them, since every round computes the new leaves'
 //! records from scratch, exactly as for an unrefined octree.
 
+use std::collections::BTreeMap;
+
 use glam::DVec2;
-use serde::{Deserialize, Serialize};
+use rayon::prelude::*;
 
-use super::regions::{FaceRegions, Tri2, UNITS};
-use crate::error::{Error, Result};
+use super::regions::FaceRegions;
+use super::round::Round;
+use crate::lie::frame::{Tri2, UNITS};
+use crate::lie::RecordKind;
+use crate::octree::{LeafId, Octree};
+use crate::scene::Scene;
 
-/// The limit of the blockers criterion.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
-pub enum MaxBlockers {
-    /// Split when one (face, light) has more than this many blockers.
-    Fixed(u32),
-    /// The thesis' adaptive limit (§8.3.3): the scene's triangle count, divided by `2 * depth` for a
-    /// leaf at depth `depth` (the thesis: "start at the triangle count, reduce by `1 / (2 level)`").
-    Adaptive,
-}
-
-impl MaxBlockers {
-    /// The limit for a leaf at `depth` in a scene of `triangles` triangles.
-    pub fn limit(self, triangles: usize, depth: u32) -> usize {
-        match self {
-            MaxBlockers::Fixed(n) => n as usize,
-            MaxBlockers::Adaptive => triangles / (2 * depth.max(1) as usize),
-        }
-    }
-}
-
-/// Which criteria refine the octree, and how far (SPEC §4.8, §4.9). The default refines nothing.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
-pub struct RefineParams {
-    /// Umbra rule 1 ([`Criterion::UmbraFull`]).
-    pub umbra_full: bool,
-    /// Umbra rule 2 ([`Criterion::UmbraFree`]).
-    pub umbra_free: bool,
-    /// Blockers per face ([`Criterion::Blockers`]) with this limit; `None`: off.
-    pub blockers: Option<MaxBlockers>,
-    /// How many times a leaf of the original octree may be split by refinement (thesis: 2).
-    pub max_split_depth: u32,
-}
-
-impl Default for RefineParams {
-    fn default() -> RefineParams {
-        RefineParams::none()
-    }
-}
-
-impl RefineParams {
-    /// No refinement.
-    pub fn none() -> RefineParams {
-        RefineParams { umbra_full: false, umbra_free: false, blockers: None, max_split_depth: 2 }
-    }
-
-    /// The thesis' test 2: refined by umbra (rules 1 and 2), at most 2 splits.
-    pub fn thesis_umbra() -> RefineParams {
-        RefineParams { umbra_full: true, umbra_free: true, ..RefineParams::none() }
-    }
-
-    /// True if some criterion is on and a leaf may split at least once.
-    pub fn enabled(&self) -> bool {
-        !self.chain().is_empty() && self.max_split_depth > 0
-    }
-
-    /// The criteria that are on, in chain order.
-    pub fn chain(&self) -> Vec<Criterion> {
-        let mut c = Vec::new();
-        if self.umbra_full {
-            c.push(Criterion::UmbraFull);
-        }
-        if self.umbra_free {
-            c.push(Criterion::UmbraFree);
-        }
-        if self.blockers.is_some() {
-            c.push(Criterion::Blockers);
-        }
-        c
-    }
-
-    /// Checks the parameters against the rest of the construction: the umbra rules need regions.
-    pub fn validate(&self, regions: bool) -> Result<()> {
-        if (self.umbra_full || self.umbra_free) && !regions {
-            return Err(Error::InvalidParameter("refinement by umbra needs umbra and penumbra regions".into()));
-        }
-        if self.max_split_depth > crate::octree::MAX_DEPTH_LIMIT {
-            return Err(Error::InvalidParameter(format!(
-                "max split depth {} is above the octree's depth limit {}",
-                self.max_split_depth,
-                crate::octree::MAX_DEPTH_LIMIT
-            )));
-        }
-        Ok(())
-    }
-}
-
-/// One link of the chain.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
-pub enum Criterion {
-    /// Umbra rule 1: a quarter of a face lies fully in its umbra.
-    UmbraFull,
-    /// Umbra rule 2: a quarter of a face with blockers touches neither umbra nor penumbra.
-    UmbraFree,
-    /// More blockers on one (face, light) than the limit.
-    Blockers,
-}
-
-impl Criterion {
-    /// Every criterion, in chain order.
-    pub const ALL: [Criterion; 3] = [Criterion::UmbraFull, Criterion::UmbraFree, Criterion::Blockers];
-
-    /// Short name (statistics, CLI).
-    pub fn name(self) -> &'static str {
-        match self {
-            Criterion::UmbraFull => "umbra_full",
-            Criterion::UmbraFree => "umbra_free",
-            Criterion::Blockers => "blockers",
-        }
-    }
-}
+pub use crate::lie::params::{Criterion, MaxBlockers, RefineParams};
 
 /// What a criterion sees of one kept record of the leaf: its blocker count and its regions.
 #[derive(Clone, Copy, Debug)]
@@ -216,6 +113,81 @@ pub fn triangle_meets_square(t: &Tri2, lo: DVec2, hi: DVec2) -> bool {
     })
 }
 
+/// The refinement's bookkeeping across rounds (stage 7): how often each leaf's region of the first
+/// octree has been split, the split nodes per round (stored in the P-LIE, replayed on load), and the
+/// splits each criterion asked for.
+pub(super) struct Refiner {
+    /// Per leaf of the current octree: times its region of the first octree has been split.
+    level: Vec<u32>,
+    /// Per round: the nodes of the leaves split, in order.
+    pub(super) splits: Vec<Vec<u32>>,
+    /// Leaves split, by the criterion that asked.
+    pub(super) by_criterion: BTreeMap<&'static str, usize>,
+}
+
+impl Refiner {
+    /// Nothing split yet on `octree`.
+    pub(super) fn new(octree: &Octree) -> Refiner {
+        Refiner { level: vec![0; octree.leaf_count()], splits: Vec::new(), by_criterion: BTreeMap::new() }
+    }
+
+    /// The progress stage name of the next round.
+    pub(super) fn stage(&self) -> String {
+        if self.splits.is_empty() {
+            "blockers".to_string()
+        } else {
+            format!("refine {}", self.splits.len())
+        }
+    }
+
+    /// The leaves the chain of criteria splits after `round`, in leaf order (none: refinement ends).
+    pub(super) fn choose(&mut self, scene: &Scene, octree: &Octree, round: &Round, p: &RefineParams) -> Vec<LeafId> {
+        let lights = scene.lights.len();
+        let triangles = scene.triangles.len();
+        let candidates: Vec<LeafId> =
+            octree.leaves().filter(|&l| self.level[l.idx()] < p.max_split_depth && octree.can_split(l)).collect();
+        let decisions: Vec<Option<Criterion>> = candidates
+            .par_iter()
+            .map(|&l| {
+                let faces: Vec<FaceView> = (0..lights)
+                    .flat_map(|i| round.tasks[l.idx() * lights + i].records.iter().flatten())
+                    .map(|r| match r.kind {
+                        RecordKind::Listed => FaceView { blockers: r.blockers.len(), regions: r.regions.as_ref() },
+                        // More blockers than the cap; its regions lack the penumbra.
+                        RecordKind::Scene => FaceView { blockers: usize::MAX, regions: None },
+                    })
+                    .collect();
+                decide(&faces, p, triangles, octree.leaf_depth(l))
+            })
+            .collect();
+        let split: Vec<LeafId> =
+            candidates.iter().zip(&decisions).filter(|(_, d)| d.is_some()).map(|(&l, _)| l).collect();
+        if !split.is_empty() {
+            for d in decisions.iter().flatten() {
+                *self.by_criterion.entry(d.name()).or_default() += 1;
+            }
+        }
+        split
+    }
+
+    /// Splits `split` (from [`Refiner::choose`]): the refined octree and, per new leaf, the leaf of
+    /// `octree` it is (`None` for a new child).
+    pub(super) fn split(&mut self, scene: &Scene, octree: &Octree, split: &[LeafId]) -> (Octree, Vec<Option<LeafId>>) {
+        self.splits.push(split.iter().map(|&l| octree.leaf_node(l).0).collect());
+        let (refined, origin) = octree.split_leaves(scene, split);
+        let kept = origin.iter().filter(|o| o.is_some()).count();
+        self.level = origin
+            .iter()
+            .enumerate()
+            .map(|(i, o)| match o {
+                Some(old) => self.level[old.idx()],
+                None => self.level[split[(i - kept) / 8].idx()] + 1,
+            })
+            .collect();
+        (refined, origin)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use glam::Vec3;
@@ -223,7 +195,8 @@ mod tests {
     use super::*;
     use crate::construct::blockers::GatherScratch;
     use crate::construct::propagation::Tolerances;
-    use crate::construct::{face_record, tolerance};
+    use crate::construct::record::face_record;
+    use crate::construct::tolerance;
     use crate::lie::PlieParams;
     use crate::octree::{Dir, Octree, OctreeParams};
     use crate::scene::{LightId, Scene, SceneBuilder};

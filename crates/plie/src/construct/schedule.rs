@@ -21,6 +21,18 @@ where
     C: Fn(usize) -> T + Sync,
     M: FnMut(usize, T) + Send,
 {
+    run_ordered_init(n, || (), |_, k| compute(k), commit);
+}
+
+/// [`run_ordered`] with per-worker state, as rayon's `map_init`: each worker makes its own state
+/// with `init` once and passes it to `compute` for every task it takes (no lock, no sharing).
+pub fn run_ordered_init<S, T, I, C, M>(n: usize, init: I, compute: C, commit: M)
+where
+    T: Send,
+    I: Fn() -> S + Sync,
+    C: Fn(&mut S, usize) -> T + Sync,
+    M: FnMut(usize, T) + Send,
+{
     let next = AtomicUsize::new(0);
     let slots: Vec<Mutex<Option<T>>> = (0..n).map(|_| Mutex::new(None)).collect();
     let committer = Mutex::new((0usize, commit));
@@ -45,14 +57,17 @@ where
     };
     rayon::scope(|s| {
         for _ in 0..rayon::current_num_threads().max(1) {
-            s.spawn(|_| loop {
-                let k = next.fetch_add(1, Ordering::Relaxed);
-                if k >= n {
-                    break;
+            s.spawn(|_| {
+                let mut state = init();
+                loop {
+                    let k = next.fetch_add(1, Ordering::Relaxed);
+                    if k >= n {
+                        break;
+                    }
+                    let v = compute(&mut state, k);
+                    *slots[k].lock().unwrap_or_else(|e| e.into_inner()) = Some(v);
+                    drain();
                 }
-                let v = compute(k);
-                *slots[k].lock().unwrap_or_else(|e| e.into_inner()) = Some(v);
-                drain();
             });
         }
     });

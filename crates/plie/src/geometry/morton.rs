@@ -1,15 +1,9 @@
-//! Morton (Z-order) codes and the spatial order of long blocker lists (SPEC §8 point 4).
-//!
-//! The construction stores every blocker list of at least [`crate::lie::CHUNKED_MIN`] triangles in
-//! the Morton order of its triangles' box centres, quantised within the list's own bounding box, so
-//! consecutive triangles lie close together; the visibility then puts a box around every chunk of
-//! [`crate::lie::CHUNK`] of them (and every group of chunks) and a shadow ray skips the chunks it
-//! misses. The order never changes an answer: a list is a set of candidates.
+//! Morton (Z-order) codes (SPEC §8 point 4): the spatial order of long blocker lists
+//! ([`crate::lie::order`]).
 
 use glam::Vec3;
 
 use super::Aabb;
-use crate::scene::{Scene, TriId};
 
 /// The 63-bit Morton code of `p`, quantised to 2^21 steps per axis of `b`.
 pub fn morton3(b: &Aabb, p: Vec3) -> u64 {
@@ -25,15 +19,6 @@ pub fn morton3(b: &Aabb, p: Vec3) -> u64 {
     let size = (b.max - b.min).max(Vec3::splat(f32::MIN_POSITIVE));
     let q = ((p - b.min) / size * STEPS).clamp(Vec3::ZERO, Vec3::splat(STEPS));
     spread(q.x as u64) | spread(q.y as u64) << 1 | spread(q.z as u64) << 2
-}
-
-/// Sorts `list` (triangles of `scene`) by the Morton code of their box centres within the list's
-/// bounding box; ties by id, so the order is a function of the set.
-pub fn sort_spatially(scene: &Scene, list: &mut [TriId]) {
-    let Some(bounds) = list.iter().map(|t| scene.triangles[t.idx()].aabb()).reduce(Aabb::union) else {
-        return;
-    };
-    list.sort_by_cached_key(|t| (morton3(&bounds, scene.triangles[t.idx()].aabb().center()), *t));
 }
 
 #[cfg(test)]

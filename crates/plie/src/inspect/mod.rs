@@ -24,11 +24,11 @@ use glam::{DVec2, DVec3, Vec3};
 
 use crate::construct::blockers::{gather_blockers, GatherScratch};
 use crate::construct::data_objects::face_sees_light;
-use crate::construct::regions::{FaceFrame, Tri2, UNITS};
 use crate::construct::shaft::Shaft;
 use crate::error::{Error, Result};
 use crate::geometry::clip::clip3;
 use crate::geometry::Aabb;
+use crate::lie::frame::{FaceFrame, Tri2, UNITS};
 use crate::lie::Plie;
 use crate::octree::{Dir, LeafId, Octree};
 use crate::scene::{LightId, Scene, TriId};

@@ -196,8 +196,8 @@ fn describe_params(p: &PlieParams) -> String {
         s += &format!(" --refine {} --max-split-depth {}", refine.join(","), r.max_split_depth);
     }
     match r.blockers {
-        Some(crate::construct::refine::MaxBlockers::Fixed(n)) => s += &format!(" --max-blockers {n}"),
-        Some(crate::construct::refine::MaxBlockers::Adaptive) => s += " --max-blockers adaptive",
+        Some(crate::lie::MaxBlockers::Fixed(n)) => s += &format!(" --max-blockers {n}"),
+        Some(crate::lie::MaxBlockers::Adaptive) => s += " --max-blockers adaptive",
         None => {}
     }
     s

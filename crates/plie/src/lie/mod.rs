@@ -5,7 +5,7 @@
 //! Layout: one `u32` per (leaf, face, light) in `record_index` (O(1) lookup, `NO_RECORD` where there is
 //! none), the records in one flat array, and all blocker lists concatenated in `blockers`. Parallel to
 //! the records: their umbra/penumbra triangles (§4.5, in the face's integer units, see
-//! [`crate::construct::regions::FaceFrame`]) and their face grids. Long blocker lists are stored in
+//! [`frame::FaceFrame`]) and their face grids. Long blocker lists are stored in
 //! Morton order ([`CHUNKED_MIN`]).
 //!
 //! Bounded storage (issue 15): a record whose shaft holds more than [`PlieParams::blocker_cap`]
@@ -14,144 +14,30 @@
 //! Its umbra, computed from a subset of its blockers, is a subset of the true umbra and still answers
 //! "occluded"; its penumbra and its lit cells are unknown, so it stores none.
 
+pub mod frame;
+pub mod grid;
+pub mod order;
+pub mod params;
 mod validate;
 
 use serde::{Deserialize, Serialize};
 
-use crate::construct::refine::RefineParams;
-use crate::construct::regions::Tri2;
+pub use frame::Tri2;
+pub use params::{Criterion, Grids, MaxBlockers, PlieParams, Propagation, RefineParams, Regions, DEFAULT_BLOCKER_CAP};
+
 use crate::octree::{Dir, LeafId};
 use crate::scene::{LightId, TriId};
 
 /// Blocker lists (of records and of face-grid cells) with at least this many triangles are stored in
-/// Morton order ([`crate::geometry::morton::sort_spatially`]); shorter ones by ascending id.
+/// Morton order ([`order::sort_spatially`]); shorter ones by ascending id.
 pub const CHUNKED_MIN: usize = 4 * CHUNK;
 
 /// Triangles per chunk when a shadow ray walks a long list: it tests a box around each chunk (and
 /// around each group of `CHUNK` chunks) first ([`crate::visibility::lie`]).
 pub const CHUNK: usize = 8;
 
-/// The cap `plie build`, `render`, `inspect` and `bench` use unless told otherwise
-/// ([`PlieParams::blocker_cap`]); chosen by the measurements of issue 15 in docs/results.md (64 built
-/// fastest and smallest of 64, 256 and 1024 on every larger scene, without slowing `grid` shading).
-pub const DEFAULT_BLOCKER_CAP: u32 = 64;
-
 /// `record_index` entry for "no data object".
 pub const NO_RECORD: u32 = u32::MAX;
-
-/// Parameters of the P-LIE construction (SPEC §4.9).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
-pub struct PlieParams {
-    /// Octree: split leaves holding more triangles than this (thesis: 200).
-    pub max_triangles: usize,
-    /// Octree: maximum depth.
-    pub max_depth: u32,
-    /// Whether to build face grids (per-cell blocker lists, our addition; used by mode `grid`).
-    pub grids: Grids,
-    /// Whether to compute umbra and penumbra (SPEC §4.5) and remove fully dark records (§4.6). The
-    /// thesis' Table 8.4 measured construction without them.
-    pub regions: Regions,
-    /// Whether to propagate umbra to neighbouring cells (SPEC §4.7, thesis chapter 6): delete the
-    /// records of faces proven dark by a fully dark neighbour without computing their blockers. Only
-    /// speeds up construction; needs regions (without them no face is known to be dark).
-    pub propagation: Propagation,
-    /// Refinement of the octree after the records are known (SPEC §4.8); off by default, as in the
-    /// thesis' test 1.
-    pub refine: RefineParams,
-    /// Most blockers a record stores (issue 15): a record with more becomes [`RecordKind::Scene`],
-    /// and gathering its blockers stops there, so construction time and storage per record are
-    /// bounded. `None`: no cap (every record lists all its blockers, as in the thesis; the library's
-    /// [`PlieParams::thesis`] and default). [`PlieParams::bounded`] sets [`DEFAULT_BLOCKER_CAP`].
-    pub blocker_cap: Option<u32>,
-}
-
-impl PlieParams {
-    /// The thesis' test 1: 200 triangles per leaf, umbra and penumbra, no refinement, nothing the
-    /// thesis did not have. Propagation is on: the thesis' construction always removes data by
-    /// umbra and propagates it (§5.7, chapter 6); test 1 only turned refinement off (§8.2.1).
-    pub fn thesis() -> PlieParams {
-        let o = crate::octree::OctreeParams::thesis();
-        PlieParams {
-            max_triangles: o.max_triangles,
-            max_depth: o.max_depth,
-            grids: Grids::Skip,
-            regions: Regions::Compute,
-            propagation: Propagation::On,
-            refine: RefineParams::none(),
-            blocker_cap: None,
-        }
-    }
-
-    /// These parameters with the default blocker cap ([`DEFAULT_BLOCKER_CAP`], issue 15): what the
-    /// command-line tool builds unless told otherwise.
-    pub fn bounded(self) -> PlieParams {
-        PlieParams { blocker_cap: Some(DEFAULT_BLOCKER_CAP), ..self }
-    }
-
-    /// Checks the parameters: the octree's ([`crate::octree::OctreeParams::validate`]) and the
-    /// refinement's, which must agree with the rest (refining by umbra needs regions).
-    pub fn validate(&self) -> crate::Result<()> {
-        self.octree().validate()?;
-        self.refine.validate(self.has_regions())
-    }
-
-    /// True if face grids are built ([`Grids::Build`]).
-    pub fn has_grids(&self) -> bool {
-        self.grids == Grids::Build
-    }
-
-    /// True if umbra and penumbra are computed ([`Regions::Compute`]).
-    pub fn has_regions(&self) -> bool {
-        self.regions == Regions::Compute
-    }
-
-    /// True if umbra is propagated: [`Propagation::On`] and regions computed.
-    pub fn propagates(&self) -> bool {
-        self.propagation == Propagation::On && self.has_regions()
-    }
-
-    /// The octree part of the parameters.
-    pub fn octree(&self) -> crate::octree::OctreeParams {
-        crate::octree::OctreeParams { max_triangles: self.max_triangles, max_depth: self.max_depth }
-    }
-}
-
-impl Default for PlieParams {
-    /// The thesis' parameters (with umbra and penumbra) plus face grids.
-    fn default() -> PlieParams {
-        PlieParams { grids: Grids::Build, ..PlieParams::thesis() }
-    }
-}
-
-/// Whether the construction builds face grids ([`PlieParams::grids`]). Stored in `.plie` files as
-/// the boolean it replaced (`Skip` = 0, `Build` = 1).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
-pub enum Grids {
-    /// No face grids: mode `grid` answers as `penumbra` (or `lie`).
-    Skip,
-    /// A face grid per record.
-    Build,
-}
-
-/// Whether the construction computes umbra and penumbra ([`PlieParams::regions`]). Stored as the
-/// boolean it replaced (`Skip` = 0, `Compute` = 1).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
-pub enum Regions {
-    /// Blocker lists only (modes `umbra` and `penumbra` refuse such a P-LIE).
-    Skip,
-    /// Umbra and penumbra per record, and removal of fully dark records.
-    Compute,
-}
-
-/// Whether the construction propagates umbra ([`PlieParams::propagation`]). Stored as the boolean
-/// it replaced (`Off` = 0, `On` = 1).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
-pub enum Propagation {
-    /// Every face's blockers are computed.
-    Off,
-    /// Faces proven dark by a dark neighbour lose their record without being computed.
-    On,
-}
 
 /// How a record answers the rays through its face beyond its umbra.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]

@@ -84,7 +84,7 @@ impl Plie {
         }
         // `unsigned_abs`: `i32::MIN.abs()` overflows (a panic in debug builds, and in release a
         // negative value that passed this check; found by the `plie_checksummed` fuzz target).
-        let limit = 4 * crate::construct::regions::UNITS as u32;
+        let limit = 4 * super::frame::UNITS as u32;
         if p.region_tris.iter().flatten().flatten().any(|&c| c.unsigned_abs() > limit) {
             return Err("region triangle out of range".into());
         }

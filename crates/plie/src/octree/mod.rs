@@ -24,14 +24,13 @@
 //! [`validate`] (invariant report).
 
 pub mod build;
-pub mod dir;
 pub mod locate;
 pub mod neighbour;
 pub mod refine;
 pub mod traverse;
 pub mod validate;
 
-pub use dir::Dir;
+pub use crate::geometry::Dir;
 pub use neighbour::Neighbour;
 
 use serde::{Deserialize, Serialize};

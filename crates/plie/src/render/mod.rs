@@ -3,7 +3,6 @@
 pub mod cpu_time;
 pub mod hit_buffer;
 pub mod path;
-pub mod renderer;
 pub mod sampler;
 pub mod shade;
 
@@ -14,30 +13,11 @@ use serde::Serialize;
 
 use crate::error::{Error, Result};
 use crate::octree::Octree;
+pub use crate::progress::{NoProgress, Progress};
 use crate::scene::{Camera, Scene};
 use crate::visibility::bvh::Bvh;
 use crate::visibility::{QueryStats, Visibility};
 pub use hit_buffer::{Hit, HitBuffer};
-pub use renderer::{Image, Integrator, Renderer, Timing};
-
-/// Reports progress of long work; the library never prints, the CLI shows a bar.
-pub trait Progress: Sync {
-    /// A stage of `total` steps begins.
-    fn start(&self, _stage: &str, _total: u64) {}
-    /// `n` more steps are done.
-    fn advance(&self, _n: u64) {}
-    /// The stage is done.
-    fn finish(&self) {}
-    /// The user asked to stop (Ctrl-C): long work that can be interrupted returns early with
-    /// an error (the P-LIE construction: [`crate::construct::Interrupted`]).
-    fn cancelled(&self) -> bool {
-        false
-    }
-}
-
-/// Progress that goes nowhere.
-pub struct NoProgress;
-impl Progress for NoProgress {}
 
 /// Image settings.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]

@@ -23,9 +23,9 @@ use super::fan::Fan;
 use super::leaf_voxels::LeafVoxels;
 use super::query::SEGMENT_EPS;
 use super::{blocks, Answer, LightRays, Mode, OctreeVisibility, QueryCtx, ShadowRay, Visibility};
-use crate::construct::grid;
-use crate::construct::regions::{in_triangles, FaceFrame};
 use crate::geometry::{Aabb, Segment};
+use crate::lie::frame::{in_triangles, FaceFrame};
+use crate::lie::grid;
 use crate::lie::{Cell, Plie, RecordKind, CHUNK, CHUNKED_MIN};
 use crate::octree::{Dir, LeafId, Octree};
 use crate::scene::{Scene, TriId};
@@ -137,7 +137,7 @@ impl<'a> LieVisibility<'a> {
     /// built for `scene` and `octree`. Without regions or grids in the P-LIE, the modes that use them
     /// test the blockers instead (still exact).
     pub fn new(scene: &'a Scene, bvh: &'a Bvh, octree: &'a Octree, plie: &'a Plie, mode: Mode) -> LieVisibility<'a> {
-        let pad = scene.scale() * crate::construct::TOLERANCE_REL;
+        let pad = scene.scale() * crate::geometry::TOLERANCE_REL;
         let tri_boxes: Vec<Aabb> = scene.triangles.iter().map(|t| t.aabb().expanded(pad)).collect();
         let voxels = LeafVoxels::new(octree, &tri_boxes, pad);
         let records = plie.records.iter().map(|r| (r.blockers_start, r.blockers_len));
@@ -152,7 +152,7 @@ impl<'a> LieVisibility<'a> {
         for leaf in octree.leaves() {
             let start = own_tris.len();
             own_tris.extend_from_slice(octree.leaf_triangles(leaf));
-            crate::geometry::morton::sort_spatially(scene, &mut own_tris[start..]);
+            crate::lie::order::sort_spatially(scene, &mut own_tris[start..]);
             own.push((start as u32, (own_tris.len() - start) as u32));
         }
         let own_boxes = ListBoxes::new(own.iter().copied(), &own_tris, &tri_boxes);

@@ -9,9 +9,7 @@ use crate::geometry::RayTest;
 use crate::octree::LeafId;
 use crate::scene::{LightId, Scene, TriId};
 
-/// The open parameter range of a shadow segment `x + t (y - x)`: `(SEGMENT_EPS, 1 - SEGMENT_EPS)`.
-/// Keeps the shaded surface's neighbours and whatever touches the light sample from counting.
-pub const SEGMENT_EPS: f32 = 1e-4;
+pub use crate::geometry::SEGMENT_EPS;
 
 /// A shadow ray from a shaded point to a sample on a light.
 #[derive(Clone, Copy, Debug)]

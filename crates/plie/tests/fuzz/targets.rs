@@ -113,7 +113,7 @@ pub fn plie_seed() -> &'static (Scene, Vec<u8>) {
         let scene = plie::scene::builtin::load("cornell-cube-1").expect("built-in scene");
         let params = plie::lie::PlieParams { grids: plie::lie::Grids::Build, ..plie::lie::PlieParams::thesis() };
         let octree = Octree::build(&scene, params.octree()).expect("valid octree parameters");
-        let built = plie::construct::build_refined(&scene, octree, params, &plie::render::NoProgress);
+        let built = plie::construct::build_refined(&scene, octree, params, &plie::NoProgress);
         let dir = tempfile::tempdir().expect("a temporary folder");
         let path = dir.path().join("seed.plie");
         save_plie(&path, &scene, &built.octree, &built.plie).expect("save the seed");

@@ -8,9 +8,9 @@ use super::Tolerances;
 use crate::construct::data_objects::face_sees_light;
 use crate::construct::regions::FaceRegions;
 use crate::geometry::Aabb;
+use crate::geometry::SEGMENT_EPS;
 use crate::octree::{Dir, LeafId, Octree};
 use crate::scene::{Light, LightId, Scene};
-use crate::visibility::query::SEGMENT_EPS;
 
 /// The state of one (leaf, face, light).
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -9,7 +9,7 @@ use glam::Vec3;
 
 use super::shapes::{rect, Facing, NO_BOTTOM};
 use crate::error::Result;
-use crate::octree::Dir;
+use crate::geometry::Dir;
 use crate::scene::{Camera, SceneBuilder};
 
 /// Rods per side of the full-size scene.

@@ -13,7 +13,7 @@ use glam::Vec3;
 
 use super::shapes::{any_perpendicular, rect, Cap, Facing, Node};
 use crate::error::Result;
-use crate::octree::Dir;
+use crate::geometry::Dir;
 use crate::scene::{Camera, MaterialId, SceneBuilder};
 
 /// Radiance of the distant light.

@@ -7,7 +7,7 @@
 use glam::Vec3;
 
 use super::shapes::{Cap, Facing, Node, Place};
-use crate::octree::Dir;
+use crate::geometry::Dir;
 use crate::scene::{MaterialId, SceneBuilder};
 
 /// Materials of the chair.

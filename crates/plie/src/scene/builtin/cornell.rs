@@ -24,7 +24,7 @@ use glam::Vec3;
 
 use super::shapes::{rect, Facing};
 use crate::error::Result;
-use crate::octree::Dir;
+use crate::geometry::Dir;
 use crate::scene::{Camera, MaterialId, SceneBuilder};
 
 /// The room's far corner: x, y, z extents in millimetres.

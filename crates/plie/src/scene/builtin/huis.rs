@@ -20,7 +20,7 @@ use super::decor;
 use super::furniture::{bookcase, desk, round_table, Bookcase, Shelving};
 use super::shapes::{rect, Facing, Place};
 use crate::error::Result;
-use crate::octree::Dir;
+use crate::geometry::Dir;
 use crate::scene::{Camera, MaterialId, SceneBuilder};
 
 /// The room's far corner.

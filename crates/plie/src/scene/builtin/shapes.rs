@@ -11,7 +11,7 @@
 
 use glam::{Vec2, Vec3};
 
-use crate::octree::Dir;
+use crate::geometry::Dir;
 use crate::scene::{MaterialId, SceneBuilder};
 
 /// Every side of a box but the bottom: a block standing on something.

@@ -4,7 +4,7 @@
 use glam::Vec3;
 use serde::{Deserialize, Serialize};
 
-use crate::geometry::Aabb;
+use super::Aabb;
 
 /// One of the six axis directions; also names the cell face whose outward normal points that way.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]

@@ -6,11 +6,12 @@ use std::path::Path;
 
 use glam::Vec3;
 
-use super::path::{render_path, PathSettings, PathStats};
-use super::{render as render_direct, NoProgress, Progress, RenderSettings};
 use crate::environment::Environment;
 use crate::error::{Error, Result};
 use crate::octree::Octree;
+use crate::progress::{NoProgress, Progress};
+use crate::render::path::{render_path, PathSettings, PathStats};
+use crate::render::{render as render_direct, RenderSettings};
 use crate::scene::{Camera, Scene};
 use crate::visibility::bvh::Bvh;
 use crate::visibility::{Mode, QueryStats, Shadows, Visibility};
