@@ -1,28 +1,35 @@
-//! Fuzz targets for the readers of hostile input (issue 16): OBJ, MTL, glTF/GLB and `.plie`; and (issue
-//! 18) Mitsuba XML scenes, PLY and Mitsuba serialized meshes.
+//! Fuzz targets for the readers of hostile input (issue 16): OBJ, MTL, glTF/GLB, `.plie`, Mitsuba XML,
+//! PLY and Mitsuba `.serialized` (issue 18).
 //!
-//! A small mutational fuzzer that runs in `cargo test` (cargo-fuzz needs a nightly toolchain and a
-//! sanitizer build of every dependency; this runs on stable): each target mutates its seed corpus
-//! (`tests/fuzz/seeds`, and for `.plie` a file built from `cornell-cube-1`) by byte flips, token
-//! insertions, deletions, duplications (long faces, repeated lines), truncations and splices, writes
-//! the case to a temporary folder and loads it. A case passes when the reader returns `Ok` or `Err`;
-//! a panic fails the target, and its input is saved under `target/fuzz-crashes/` to be added to
-//! `tests/fuzz/regressions/`, whose files every run loads first.
+//! The targets' bodies are in `tests/fuzz/targets.rs`, shared with the cargo-fuzz binaries of `fuzz/`
+//! (coverage-guided, run by `scripts/fuzz.sh` and `.ci/run`). Here they run on stable inside
+//! `cargo test`, in three ways:
+//!
+//! - every committed input of `fuzz/seeds/TARGET/` and `fuzz/regressions/TARGET/` (cargo-fuzz's seeds
+//!   and the inputs it once failed on), and the older `tests/fuzz/regressions/` files;
+//! - a small mutational fuzzer: each target mutates its seeds (`tests/fuzz/seeds`, and for `.plie` a
+//!   file built from `cornell-cube-1`) by byte flips, token insertions, deletions, duplications (long
+//!   faces, repeated lines), truncations and splices. A panic or a case over 20 s fails the target,
+//!   and its input is saved under `target/fuzz-crashes/`.
 //!
 //! `cargo test -p plie --test fuzz` runs `PLIE_FUZZ_CASES` cases per target (default 60, fixed seeds:
 //! the same cases every run). `PLIE_FUZZ_SECONDS=60` runs each target for that many seconds instead,
-//! and `PLIE_FUZZ_SEED` changes the seed (`.ci/run` and docs/robustness.md).
+//! and `PLIE_FUZZ_SEED` changes the seed (docs/robustness.md).
 
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
-use plie::io::plie_file::{load_plie, save_plie};
-use plie::io::{load_scene, LoadOptions};
-use plie::octree::Octree;
+#[path = "fuzz/targets.rs"]
+mod targets;
 
 fn fuzz_dir() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fuzz")
+}
+
+/// The cargo-fuzz folder `fuzz/` at the repository's root.
+fn cargo_fuzz_dir() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fuzz")
 }
 
 fn seed(name: &str) -> Vec<u8> {
@@ -64,13 +71,6 @@ const TOKENS: &[&str] = &[
     "null",
     "\"uri\"",
     "\"POSITION\"",
-    "<shape type=\"ply\">",
-    "<ref id=\"g\"/>",
-    "<include filename=\"scene.xml\"/>",
-    "$r",
-    "element vertex 4294967295",
-    "property list uint uint vertex_indices",
-    "format binary_big_endian 1.0",
     "\"accessors\"",
     "\"count\"",
     "\"byteLength\"",
@@ -165,10 +165,9 @@ fn budget() -> Budget {
 /// The longest a single case may take (a hang shows up as a failure, not a stuck run).
 const CASE_LIMIT: Duration = Duration::from_secs(20);
 
-/// Runs `target` on mutations of `seeds` (file name in the case folder, contents) within the budget;
-/// `target` gets the folder and returns nothing (its `Result` is dropped): only panics and slow cases
-/// fail. The first file of `seeds` is the one mutated; the others are written unchanged beside it.
-fn fuzz(name: &str, seeds: &[(&str, Vec<u8>)], target: impl Fn(&Path)) {
+/// Runs `target` on mutations of `seeds[0]` (splicing from any of `seeds`) within the budget: only
+/// panics and slow cases fail. `ext` names saved inputs.
+fn fuzz(name: &str, ext: &str, seeds: &[Vec<u8>], target: impl Fn(&[u8])) {
     let base: u64 = std::env::var("PLIE_FUZZ_SEED").ok().and_then(|s| s.parse().ok()).unwrap_or(16);
     let mut rng = Rng(base ^ fnv(name.as_bytes()));
     let start = Instant::now();
@@ -180,19 +179,13 @@ fn fuzz(name: &str, seeds: &[(&str, Vec<u8>)], target: impl Fn(&Path)) {
             Budget::Time(t) if start.elapsed() >= t => break,
             _ => {}
         }
-        let (file, data) = &seeds[0];
-        let other = &seeds[rng.below(seeds.len())].1;
-        let input = mutate(data, other, &mut rng);
-        let dir = tempfile::tempdir().unwrap();
-        std::fs::write(dir.path().join(file), &input).unwrap();
-        for (f, d) in &seeds[1..] {
-            std::fs::write(dir.path().join(f), d).unwrap();
-        }
+        let other = &seeds[rng.below(seeds.len())];
+        let input = mutate(&seeds[0], other, &mut rng);
         let t = Instant::now();
-        let outcome = catch_unwind(AssertUnwindSafe(|| target(dir.path())));
+        let outcome = catch_unwind(AssertUnwindSafe(|| target(&input)));
         let slow = t.elapsed() > CASE_LIMIT;
         if outcome.is_err() || slow {
-            let saved = save_crash(name, file, &input);
+            let saved = save_crash(name, ext, &input);
             let why = if slow { format!("took {:.1} s", t.elapsed().as_secs_f64()) } else { "panicked".into() };
             failures.push(format!("{name} case {cases} {why}: input saved as {}", saved.display()));
         }
@@ -203,10 +196,9 @@ fn fuzz(name: &str, seeds: &[(&str, Vec<u8>)], target: impl Fn(&Path)) {
 }
 
 /// Saves a failing input under `target/fuzz-crashes/`.
-fn save_crash(name: &str, file: &str, input: &[u8]) -> PathBuf {
+fn save_crash(name: &str, ext: &str, input: &[u8]) -> PathBuf {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../target/fuzz-crashes");
     std::fs::create_dir_all(&dir).unwrap();
-    let ext = Path::new(file).extension().map(|e| e.to_string_lossy().into_owned()).unwrap_or_default();
     let path = dir.join(format!("{name}-{:016x}.{ext}", fnv(input)));
     std::fs::write(&path, input).unwrap();
     path
@@ -217,142 +209,109 @@ fn fnv(b: &[u8]) -> u64 {
     b.iter().fold(0xcbf2_9ce4_8422_2325u64, |h, &x| (h ^ x as u64).wrapping_mul(0x100_0000_01b3))
 }
 
-/// Loads a scene and, when it loads, builds its octree (where coincident triangles once exploded).
-fn load_and_build(path: &Path) {
-    if let Ok(scene) = load_scene(path) {
-        let _ = Octree::build(&scene, plie::octree::OctreeParams::default()).expect("valid octree parameters");
-    }
-}
-
 #[test]
 fn fuzz_obj() {
-    let seeds = [("scene.obj", seed("scene.obj")), ("quad-light.mtl", seed("quad-light.mtl"))];
-    fuzz("obj", &seeds, |d| load_and_build(&d.join("scene.obj")));
+    fuzz("obj", "obj", &[seed("scene.obj"), seed("quad-light.mtl")], targets::obj);
 }
 
 #[test]
 fn fuzz_mtl() {
-    let seeds = [("quad-light.mtl", seed("quad-light.mtl")), ("scene.obj", seed("scene.obj"))];
-    fuzz("mtl", &seeds, |d| load_and_build(&d.join("scene.obj")));
+    fuzz("mtl", "mtl", &[seed("quad-light.mtl"), seed("scene.obj")], targets::mtl);
 }
 
 #[test]
 fn fuzz_gltf() {
-    let seeds = [("embedded.gltf", seed("embedded.gltf")), ("external.gltf", seed("external.gltf"))];
-    fuzz("gltf", &seeds, |d| load_and_build(&d.join("embedded.gltf")));
-    let seeds = [("external.gltf", seed("external.gltf")), ("external.bin", seed("external.bin"))];
-    fuzz("gltf-external", &seeds, |d| load_and_build(&d.join("external.gltf")));
+    fuzz("gltf", "gltf", &[seed("embedded.gltf"), seed("external.gltf")], targets::gltf);
+    fuzz("gltf-external", "gltf", &[seed("external.gltf"), seed("external.bin")], targets::gltf);
 }
 
 #[test]
 fn fuzz_glb() {
-    let seeds = [("scene.glb", seed("scene.glb")), ("embedded.gltf", seed("embedded.gltf"))];
-    fuzz("glb", &seeds, |d| load_and_build(&d.join("scene.glb")));
-}
-
-/// The files a Mitsuba seed scene names.
-fn mitsuba_files() -> Vec<(&'static str, Vec<u8>)> {
-    ["mesh.ply", "mesh-binary.ply", "mesh.serialized", "tex.png"].into_iter().map(|f| (f, seed(f))).collect()
+    fuzz("glb", "glb", &[seed("scene.glb"), seed("embedded.gltf")], targets::glb);
 }
 
 #[test]
 fn fuzz_mitsuba_xml() {
-    let seeds: Vec<(&str, Vec<u8>)> =
-        std::iter::once(("scene.xml", seed("scene.xml"))).chain(mitsuba_files()).collect();
-    fuzz("mitsuba-xml", &seeds, |d| load_and_build(&d.join("scene.xml")));
+    fuzz("mitsuba-xml", "xml", &[seed("scene.xml"), seed("mesh.ply")], targets::mitsuba_xml);
 }
 
 #[test]
 fn fuzz_ply() {
-    for first in ["mesh.ply", "mesh-binary.ply"] {
-        let mut seeds: Vec<(&str, Vec<u8>)> = vec![(first, seed(first))];
-        seeds.extend(mitsuba_files().into_iter().filter(|(f, _)| *f != first));
-        seeds.push(("scene.xml", seed("scene.xml")));
-        fuzz(&format!("ply-{first}"), &seeds, |d| {
-            let _ = plie::io::ply::load_ply(&d.join(first));
-            load_and_build(&d.join("scene.xml"));
-        });
-    }
+    fuzz("ply", "ply", &[seed("mesh.ply"), seed("mesh-binary.ply")], targets::ply);
+    fuzz("ply-binary", "ply", &[seed("mesh-binary.ply"), seed("mesh.ply")], targets::ply);
 }
 
 #[test]
 fn fuzz_serialized() {
-    let mut seeds: Vec<(&str, Vec<u8>)> = vec![("mesh.serialized", seed("mesh.serialized"))];
-    seeds.extend(mitsuba_files().into_iter().filter(|(f, _)| *f != "mesh.serialized"));
-    seeds.push(("scene.xml", seed("scene.xml")));
-    fuzz("serialized", &seeds, |d| {
-        for i in 0..3 {
-            let _ = plie::io::serialized::load_serialized(&d.join("mesh.serialized"), i);
-        }
-        load_and_build(&d.join("scene.xml"));
-    });
-}
-
-/// A `.plie` file of cornell-cube-1 (built here: the format's version may change).
-fn plie_seed() -> (plie::Scene, Vec<u8>) {
-    let scene = plie::scene::builtin::load("cornell-cube-1").unwrap();
-    let params = plie::lie::PlieParams { grids: plie::lie::Grids::Build, ..plie::lie::PlieParams::thesis() };
-    let octree = Octree::build(&scene, params.octree()).expect("valid octree parameters");
-    let built = plie::construct::build_refined(&scene, octree, params, &plie::render::NoProgress);
-    let dir = tempfile::tempdir().unwrap();
-    let path = dir.path().join("seed.plie");
-    save_plie(&path, &scene, &built.octree, &built.plie).unwrap();
-    (scene, std::fs::read(&path).unwrap())
-}
-
-/// Loads a `.plie` file, with its checksum rewritten when `fix_checksum` (as the issue's fuzzer did),
-/// and, when it loads, answers sampled shadow rays with it: altered data must not panic a mode.
-fn load_plie_case(scene: &plie::Scene, path: &Path, fix_checksum: bool) {
-    if fix_checksum {
-        let mut b = std::fs::read(path).unwrap();
-        if b.len() >= 28 {
-            let sum = plie_checksum(&b[28..]);
-            b[20..28].copy_from_slice(&sum.to_le_bytes());
-            std::fs::write(path, &b).unwrap();
-        }
-    }
-    if let Ok((octree, plie)) = load_plie(path, scene, None) {
-        let _ = plie::verify::verify_sample(scene, &octree, &plie, 8, 4, 1);
-    }
-}
-
-/// The `.plie` checksum (XXH3-64 of the payload), through the library's own reader: a file whose
-/// header is rewritten with it passes the checksum.
-fn plie_checksum(payload: &[u8]) -> u64 {
-    plie::io::plie_file::checksum(payload)
+    fuzz("serialized", "serialized", &[seed("mesh.serialized")], targets::serialized);
 }
 
 #[test]
 fn fuzz_plie() {
-    let (scene, bytes) = plie_seed();
-    let seeds = [("f.plie", bytes.clone())];
-    fuzz("plie", &seeds, |d| load_plie_case(&scene, &d.join("f.plie"), false));
-    fuzz("plie-checksummed", &seeds, |d| load_plie_case(&scene, &d.join("f.plie"), true));
+    let seeds = [targets::plie_seed().1.clone()];
+    fuzz("plie", "plie", &seeds, |b| targets::plie_file(b, false));
+    fuzz("plie-checksummed", "plie", &seeds, |b| targets::plie_file(b, true));
 }
 
-/// Every saved crash input loads without a panic (scene files as scenes, `.plie` files for
-/// cornell-cube-1).
+/// The `.plie` targets reach past the loader: their seed loads, so `verify` runs on what loads.
+#[test]
+fn the_plie_seed_loads() {
+    let (scene, bytes) = targets::plie_seed();
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("seed.plie");
+    std::fs::write(&path, bytes).unwrap();
+    plie::io::plie_file::load_plie(&path, scene, None).unwrap();
+    // The edits keep an empty program's input as it is and change it otherwise.
+    assert_eq!(&targets::apply_edits(bytes, &[]), bytes);
+    assert_ne!(&targets::apply_edits(bytes, &[1, 91, 1, 0, 0, 51, 0]), bytes);
+}
+
+/// Every committed input of the cargo-fuzz targets (`fuzz/seeds/TARGET/`, and the inputs a run once
+/// failed on, `fuzz/regressions/TARGET/`) runs through its target without a panic; every folder
+/// names a target.
+#[test]
+fn cargo_fuzz_seeds_and_regressions() {
+    let mut n = 0;
+    for kind in ["seeds", "regressions"] {
+        let Ok(dirs) = std::fs::read_dir(cargo_fuzz_dir().join(kind)) else { continue };
+        for dir in dirs {
+            let dir = dir.unwrap().path();
+            if !dir.is_dir() {
+                continue;
+            }
+            let name = dir.file_name().unwrap().to_string_lossy().into_owned();
+            let target = targets::TARGETS.iter().find(|(t, _)| *t == name);
+            let Some((_, target)) = target else { panic!("fuzz/{kind}/{name}: no such target") };
+            for f in std::fs::read_dir(&dir).unwrap() {
+                let f = f.unwrap().path();
+                if f.is_file() {
+                    target(&std::fs::read(&f).unwrap());
+                    n += 1;
+                }
+            }
+        }
+    }
+    eprintln!("cargo-fuzz seeds and regressions: {n} inputs");
+    assert!(n >= targets::TARGETS.len(), "{n} inputs");
+}
+
+/// Every input of `tests/fuzz/regressions/` (kept before the cargo-fuzz targets) loads without a panic
+/// (scene files as scenes, `.plie` files for cornell-cube-1).
 #[test]
 fn regressions() {
     let dir = fuzz_dir().join("regressions");
     let mut n = 0;
-    let scene = plie::scene::builtin::load("cornell-cube-1").unwrap();
     for entry in std::fs::read_dir(&dir).unwrap() {
         let path = entry.unwrap().path();
+        let bytes = std::fs::read(&path).unwrap();
         match path.extension().and_then(|e| e.to_str()) {
-            Some("obj" | "gltf" | "glb" | "xml") => {
-                let _ = plie::io::load_scene_with(&path, LoadOptions::default());
-                load_and_build(&path);
-            }
-            Some("plie") => {
-                let _ = load_plie(&path, &scene, None);
-            }
-            Some("ply") => {
-                let _ = plie::io::ply::load_ply(&path);
-            }
-            Some("serialized") => {
-                let _ = plie::io::serialized::load_serialized(&path, 0);
-            }
+            Some("obj") => targets::obj(&bytes),
+            Some("gltf") => targets::gltf(&bytes),
+            Some("glb") => targets::glb(&bytes),
+            Some("plie") => targets::plie_file(&bytes, false),
+            Some("xml") => targets::mitsuba_xml(&bytes),
+            Some("ply") => targets::ply(&bytes),
+            Some("serialized") => targets::serialized(&bytes),
             _ => continue,
         }
         n += 1;

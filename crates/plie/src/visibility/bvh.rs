@@ -9,14 +9,27 @@
 //! `1e-4`, and a clamped inverse still keeps every point at least `PAD` inside a padded box within
 //! `PAD / EPSILON > SEGMENT_T` of the interval; rounding in the slab test is far below `PAD`. Candidates
 //! are then decided by the shared [`blocks`] predicate, so answers equal brute force.
-
-use std::time::Duration;
+//!
+//! obvhs' traversal keeps the groups still to visit on a fixed 32-entry stack that, when full,
+//! overwrites its top entry: a BVH deeper than 31 inner levels (hundreds of coincident triangles, whose
+//! identical boxes PLOC pairs into a chain) would silently skip nodes. [`Bvh::build`] measures the
+//! depth, and traversals of a deeper BVH use a growable stack instead ([`Walk`]); the common, shallow
+//! case keeps obvhs' fixed stack. Boxes with one centre (exact copies, instances with one transform,
+//! triangles nested around a point) also made PLOC's build quadratic (5,000 copies of a triangle:
+//! 1.5 s and a depth of 713; 20,000 glTF instances: 70 s): PLOC orders boxes by the Morton code of
+//! their centres and cannot order equal codes. So more than [`CROWD_LIMIT`] boxes whose centres share
+//! a Morton cell become one primitive listing their triangles ([`Groups`]); ordinary scenes have no
+//! such crowd and keep one primitive per triangle.
 
 use glam::{UVec2, Vec3, Vec3A};
 use obvhs::aabb::Aabb as BAabb;
-use obvhs::cwbvh::{builder::build_cwbvh, CwBvh};
+use obvhs::bvh2::reinsertion::ReinsertionOptimizer;
+use obvhs::cwbvh::{bvh2_to_cwbvh::bvh2_to_cwbvh, CwBvh};
+use obvhs::faststack::{FastStack, StackStack};
+use obvhs::ploc::PlocBuilder;
 use obvhs::ray::Ray;
 use obvhs::BvhBuildParams;
+use rayon::prelude::*;
 
 use super::{blocks, QueryCtx, ShadowRay, Visibility};
 use crate::geometry::RayTest;
@@ -28,17 +41,82 @@ const NORMALISED_SIZE: f32 = 1000.0;
 const PAD: f32 = 1e-2;
 /// The `t` at which a shadow ray reaches its light sample in BVH space.
 const SEGMENT_T: f32 = 1e4;
+/// Entries of obvhs' fixed traversal stack (`TRAVERSAL_STACK_SIZE`, private there). Its `push` on a
+/// full stack overwrites the top entry, so it holds `FIXED_STACK - 1` entries without loss.
+const FIXED_STACK: usize = 32;
+
+/// More boxes than this with their centres in one Morton cell ([`group_crowded_centres`]) are one
+/// BVH primitive. Two is common (both halves of an axis-aligned rectangle share their box), more rare.
+pub const CROWD_LIMIT: usize = 8;
 
 /// A BVH over the scene's triangles.
 pub struct Bvh {
     cw: CwBvh,
     origin: Vec3,
     scale: f32,
+    /// Depth of the deepest inner node (the root is 0): the most entries a traversal stack holds.
+    depth: u32,
+    /// The triangles of each primitive when some centres were crowded ([`CROWD_LIMIT`]); else every
+    /// primitive is the triangle of the same index.
+    groups: Option<Groups>,
+}
+
+/// The triangles of each BVH primitive `p`: `tris[starts[p]..starts[p + 1]]`.
+struct Groups {
+    starts: Vec<u32>,
+    tris: Vec<u32>,
+}
+
+/// The triangles of a BVH primitive. Traversals are compiled for each kind, so the common one
+/// ([`Single`]) pays nothing for the other.
+trait Prims {
+    /// The triangles of primitive `*p` (`p` points into the BVH's primitive index array).
+    fn of<'a>(&'a self, p: &'a u32) -> &'a [u32];
+}
+
+/// Every primitive is the triangle of the same index.
+struct Single;
+
+impl Prims for Single {
+    #[inline(always)]
+    fn of<'a>(&'a self, p: &'a u32) -> &'a [u32] {
+        std::slice::from_ref(p)
+    }
+}
+
+impl Prims for Groups {
+    #[inline(always)]
+    fn of<'a>(&'a self, p: &'a u32) -> &'a [u32] {
+        &self.tris[self.starts[*p as usize] as usize..self.starts[*p as usize + 1] as usize]
+    }
+}
+
+/// Calls `$f($stack, $prims, args...)` with the traversal stack and primitive kind `$bvh` needs.
+macro_rules! dispatch {
+    ($bvh:expr, $f:expr $(, $arg:expr)*) => {{
+        let deep = || Vec::with_capacity($bvh.depth as usize + 1);
+        match (&$bvh.groups, $bvh.fixed_stack_fits()) {
+            (None, true) => $f(&mut StackStack::<UVec2, FIXED_STACK>::default(), &Single, $($arg),*),
+            (None, false) => $f(&mut deep(), &Single, $($arg),*),
+            (Some(g), true) => $f(&mut StackStack::<UVec2, FIXED_STACK>::default(), g, $($arg),*),
+            (Some(g), false) => $f(&mut deep(), g, $($arg),*),
+        }
+    }};
 }
 
 impl Bvh {
     /// Builds the BVH (in parallel).
     pub fn build(scene: &Scene) -> Bvh {
+        Bvh::build_with(scene, true)
+    }
+
+    /// As [`Bvh::build`], one primitive per triangle even where centres crowd (for tests of deep BVHs).
+    #[cfg(test)]
+    fn build_ungrouped(scene: &Scene) -> Bvh {
+        Bvh::build_with(scene, false)
+    }
+
+    fn build_with(scene: &Scene, group: bool) -> Bvh {
         let origin = scene.bounds.min;
         let scale = NORMALISED_SIZE / scene.scale().max(f32::MIN_POSITIVE);
         let boxes: Vec<BAabb> = scene
@@ -51,13 +129,34 @@ impl Bvh {
                 BAabb::new(lo, hi)
             })
             .collect();
-        let cw = build_cwbvh(&boxes, BvhBuildParams::medium_build(), &mut Duration::default());
-        Bvh { cw, origin, scale }
+        let (cw, groups) = match group.then(|| group_crowded_centres(&boxes)).flatten() {
+            None => (build_cwbvh(&boxes, BvhBuildParams::medium_build()), None),
+            Some((prim_boxes, groups)) => (build_cwbvh(&prim_boxes, BvhBuildParams::medium_build()), Some(groups)),
+        };
+        let depth = inner_depth(&cw);
+        Bvh { cw, origin, scale, depth, groups }
+    }
+
+    /// Number of BVH primitives (triangles, or groups of triangles with crowded centres).
+    pub fn primitive_count(&self) -> usize {
+        self.cw.primitive_indices.len()
+    }
+
+    /// Depth of the deepest inner node (the root is 0). Above 31, traversals use a growable stack.
+    pub fn depth(&self) -> u32 {
+        self.depth
+    }
+
+    /// Whether obvhs' fixed stack holds every entry a traversal of this BVH pushes: at most one per
+    /// inner level above the node visited, so at most [`Bvh::depth`].
+    fn fixed_stack_fits(&self) -> bool {
+        (self.depth as usize) < FIXED_STACK
     }
 
     /// Bytes used by the nodes and index array.
     pub fn memory_bytes(&self) -> usize {
-        self.cw.nodes.len() * std::mem::size_of_val(&self.cw.nodes[0]) + self.cw.primitive_indices.len() * 4
+        let groups = self.groups.as_ref().map_or(0, |g| (g.starts.len() + g.tris.len()) * 4);
+        self.cw.nodes.len() * std::mem::size_of_val(&self.cw.nodes[0]) + self.cw.primitive_indices.len() * 4 + groups
     }
 
     fn to_local(&self, p: Vec3) -> Vec3A {
@@ -80,23 +179,39 @@ impl Bvh {
         t_min: f32,
         skip: Option<TriId>,
     ) -> Option<(TriId, f32)> {
+        dispatch!(self, |st, pr| self.closest_hit_with(st, pr, scene, origin, dir, t_min, skip))
+    }
+
+    /// [`Bvh::closest_hit_from`] with `stack` as the traversal stack.
+    #[allow(clippy::too_many_arguments)]
+    fn closest_hit_with<S: FastStack<UVec2>, P: Prims>(
+        &self,
+        stack: &mut S,
+        prims: &P,
+        scene: &Scene,
+        origin: Vec3,
+        dir: Vec3,
+        t_min: f32,
+        skip: Option<TriId>,
+    ) -> Option<(TriId, f32)> {
         let test = RayTest::new(origin, dir, t_min, f32::INFINITY);
         // Unit direction in normalised space: t_local = t_world * scale.
         let ray = Ray::new(self.to_local(origin), Vec3A::from(dir), 0.0, f32::INFINITY);
         let mut best: Option<(TriId, f32)> = None;
-        let mut state = self.cw.new_traversal(ray.direction);
+        let mut state = Walk::new(&self.cw, ray.direction, stack);
         let mut node;
         let mut r = ray;
         obvhs::traverse!(self.cw, node, state, node.intersect_ray(&r, state.oct_inv4), {
-            let tri = self.cw.primitive_indices[state.primitive_id as usize];
-            if skip == Some(TriId(tri)) {
-                continue;
-            }
-            if let Some(t) = test.hit(&scene.triangles[tri as usize]) {
-                let tl = t * self.scale;
-                if tl < r.tmax {
-                    r.tmax = tl;
-                    best = Some((TriId(tri), t));
+            for &tri in prims.of(&self.cw.primitive_indices[state.primitive_id as usize]) {
+                if skip == Some(TriId(tri)) {
+                    continue;
+                }
+                if let Some(t) = test.hit(&scene.triangles[tri as usize]) {
+                    let tl = t * self.scale;
+                    if tl < r.tmax {
+                        r.tmax = tl;
+                        best = Some((TriId(tri), t));
+                    }
                 }
             }
         });
@@ -127,19 +242,323 @@ impl Visibility for BvhVisibility<'_> {
 /// deciding candidates with the shared [`blocks`] predicate: brute force's answer. The `bvh` mode, and
 /// the P-LIE modes for records that store no list ([`crate::lie::RecordKind::Scene`]), use it.
 pub(crate) fn segment_occluded(scene: &Scene, bvh: &Bvh, ray: &ShadowRay, ctx: &mut QueryCtx) -> bool {
+    dispatch!(bvh, segment_occluded_with, scene, bvh, ray, ctx)
+}
+
+/// [`segment_occluded`] with `stack` as the traversal stack.
+fn segment_occluded_with<S: FastStack<UVec2>, P: Prims>(
+    stack: &mut S,
+    prims: &P,
+    scene: &Scene,
+    bvh: &Bvh,
+    ray: &ShadowRay,
+    ctx: &mut QueryCtx,
+) -> bool {
     let dir = Vec3A::from(ray.test.dir * (bvh.scale / SEGMENT_T));
     let r = Ray::new(bvh.to_local(ray.test.origin), dir, 0.0, SEGMENT_T * (1.0 + 1e-6));
-    let mut state = bvh.cw.new_traversal(r.direction);
+    let mut state = Walk::new(&bvh.cw, r.direction, stack);
     let mut node;
     let mut hit = false;
     'outer: {
         obvhs::traverse!(bvh.cw, node, state, node.intersect_ray(&r, state.oct_inv4), {
-            let tri = TriId(bvh.cw.primitive_indices[state.primitive_id as usize]);
-            if blocks(scene, ray, tri, ctx) {
-                hit = true;
-                break 'outer;
+            for &tri in prims.of(&bvh.cw.primitive_indices[state.primitive_id as usize]) {
+                if blocks(scene, ray, TriId(tri), ctx) {
+                    hit = true;
+                    break 'outer;
+                }
             }
         });
     }
     hit
+}
+
+/// obvhs' `build_cwbvh` (PLOC, reinsertion, conversion to BVH8) without its debug-build `validate`,
+/// which asserts that the depth fits obvhs' fixed stack: here a deeper BVH is valid ([`Walk`]).
+fn build_cwbvh(boxes: &[BAabb], config: BvhBuildParams) -> CwBvh {
+    let indices = (0..boxes.len() as u32).collect::<Vec<_>>();
+    let mut bvh2 = PlocBuilder::with_capacity(boxes.len()).build(
+        config.ploc_search_distance,
+        boxes,
+        indices,
+        config.sort_precision,
+        config.search_depth_threshold,
+    );
+    ReinsertionOptimizer::default().run(&mut bvh2, config.reinsertion_batch_ratio, None);
+    bvh2_to_cwbvh(&bvh2, config.max_prims_per_leaf.clamp(1, 3), true, false)
+}
+
+/// Cells per axis of the grid that [`group_crowded_centres`] puts box centres in: 2^21, the
+/// resolution of the 63-bit Morton codes PLOC sorts by (`SortPrecision::U64`).
+const CENTRE_CELLS: f64 = (1u32 << 21) as f64;
+
+/// When more than [`CROWD_LIMIT`] boxes have their centres in one cell of a 2^21-per-axis grid over
+/// the normalised scene (so one Morton code, which PLOC cannot order: exact copies, instances with
+/// one transform, or triangles nested around one centre): the primitives' boxes (one per crowded
+/// cell, the union of its boxes, and one per other triangle, in order of first appearance) and their
+/// triangles.
+fn group_crowded_centres(boxes: &[BAabb]) -> Option<(Vec<BAabb>, Groups)> {
+    let per_unit = CENTRE_CELLS / f64::from(NORMALISED_SIZE + 2.0 * PAD);
+    // The cell as one number: 21 bits per axis.
+    let cell = |b: &BAabb| {
+        let c = (b.min + b.max) * 0.5;
+        let [x, y, z] = c.to_array().map(|x| (f64::from(x + PAD) * per_unit).clamp(0.0, CENTRE_CELLS - 1.0) as u64);
+        x << 42 | y << 21 | z
+    };
+    // Whether any cell holds more than the limit: sorted, a crowd is a run (the common case ends here).
+    let mut sorted: Vec<u64> = boxes.par_iter().map(cell).collect();
+    sorted.par_sort_unstable();
+    if !sorted.windows(CROWD_LIMIT + 1).any(|w| w[0] == w[CROWD_LIMIT]) {
+        return None;
+    }
+    let mut count = std::collections::HashMap::new();
+    for run in sorted.chunk_by(|a, b| a == b) {
+        count.insert(run[0], run.len());
+    }
+    let cells: Vec<u64> = boxes.iter().map(cell).collect();
+    let mut crowd = std::collections::HashMap::new();
+    let mut members: Vec<Vec<u32>> = Vec::new();
+    let mut prim_boxes: Vec<BAabb> = Vec::new();
+    for (t, (b, c)) in boxes.iter().zip(&cells).enumerate() {
+        if count[c] > CROWD_LIMIT {
+            let p = *crowd.entry(*c).or_insert_with(|| {
+                prim_boxes.push(*b);
+                members.push(Vec::new());
+                members.len() - 1
+            });
+            prim_boxes[p] = prim_boxes[p].union(b);
+            members[p].push(t as u32);
+        } else {
+            prim_boxes.push(*b);
+            members.push(vec![t as u32]);
+        }
+    }
+    let mut starts = Vec::with_capacity(members.len() + 1);
+    let mut tris = Vec::with_capacity(boxes.len());
+    starts.push(0);
+    for m in members {
+        tris.extend(m);
+        starts.push(tris.len() as u32);
+    }
+    Some((prim_boxes, Groups { starts, tris }))
+}
+
+/// Depth of the deepest inner node of `cw` (the root is 0; 0 for an empty BVH). The inner children of
+/// a node are the `imask.count_ones()` nodes from its `child_base_idx` on.
+fn inner_depth(cw: &CwBvh) -> u32 {
+    let mut deepest = 0;
+    let mut todo = if cw.nodes.is_empty() { vec![] } else { vec![(0u32, 0u32)] };
+    while let Some((n, d)) = todo.pop() {
+        deepest = deepest.max(d);
+        let node = &cw.nodes[n as usize];
+        todo.extend((0..node.imask.count_ones()).map(|k| (node.child_base_idx + k, d + 1)));
+    }
+    deepest
+}
+
+/// The traversal state `obvhs::traverse!` works on (the fields of obvhs' `Traversal`), with a stack of
+/// our choosing: obvhs' fixed one or a growable `Vec`.
+struct Walk<S> {
+    stack: S,
+    current_group: UVec2,
+    primitive_group: UVec2,
+    oct_inv4: u32,
+    primitive_id: u32,
+    hitmask: u32,
+}
+
+impl<'a, S: FastStack<UVec2>> Walk<&'a mut S> {
+    /// The state at the root of `cw` for rays in direction `dir`, with `stack` emptied.
+    fn new(cw: &CwBvh, dir: Vec3A, stack: &'a mut S) -> Walk<&'a mut S> {
+        stack.clear();
+        let t = cw.new_traversal(dir);
+        Walk {
+            stack,
+            current_group: t.current_group,
+            primitive_group: t.primitive_group,
+            oct_inv4: t.oct_inv4,
+            primitive_id: t.primitive_id,
+            hitmask: t.hitmask,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::{LightId, SceneBuilder};
+    use crate::visibility::Brute;
+
+    /// A 20 x 20 grid of floor quads, `copies` copies of a triangle at height 1 above part of it, the
+    /// `k`-th `1 + k * grow` times as wide (the same box centre), 60 small distinct blockers between
+    /// them and the light (a quad at height 3).
+    fn scene_with_copies(copies: usize, grow: f32) -> Scene {
+        let mut b = SceneBuilder::new("copies");
+        let m = b.diffuse("white", Vec3::splat(0.5));
+        for i in 0..20 {
+            for j in 0..20 {
+                let (x, z) = (i as f32 * 0.2 - 2.0, j as f32 * 0.2 - 2.0);
+                let p = |dx: f32, dz: f32| Vec3::new(x + dx, 0.0, z + dz);
+                b.quad(p(0.0, 0.0), p(0.0, 0.2), p(0.2, 0.2), p(0.2, 0.0), m);
+            }
+        }
+        for k in 0..copies {
+            let r = 1.0 + k as f32 * grow;
+            b.triangle(Vec3::new(-r, 1.0, -r), Vec3::new(-r, 1.0, r), Vec3::new(r, 1.0, 0.0), m);
+        }
+        for k in 0..60 {
+            let a = k as f32 * 0.61;
+            let c = Vec3::new(1.6 * a.cos() * (k as f32 / 60.0), 1.5 + 0.01 * k as f32, 1.6 * a.sin());
+            b.triangle(c, c + Vec3::new(0.0, 0.0, 0.3), c + Vec3::new(0.3, 0.02, 0.0), m);
+        }
+        let l = |x: f32, z: f32| Vec3::new(x, 3.0, z);
+        b.light("light", &[l(-1.5, -1.5), l(1.5, -1.5), l(1.5, 1.5), l(-1.5, 1.5)], Vec3::ONE);
+        b.build().unwrap()
+    }
+
+    /// Shadow rays from every floor triangle's centre to a 5 x 5 grid of light samples.
+    fn shadow_rays(scene: &Scene) -> Vec<ShadowRay> {
+        let mut rays = Vec::new();
+        for (t, tri) in scene.triangles.iter().enumerate().filter(|(_, tri)| tri.v.iter().all(|v| v.y == 0.0)) {
+            let x = (tri.v[0] + tri.v[1] + tri.v[2]) / 3.0;
+            for i in 0..5 {
+                for j in 0..5 {
+                    let y = Vec3::new(i as f32 * 0.7 - 1.4, 3.0, j as f32 * 0.7 - 1.4);
+                    rays.push(ShadowRay::new(x, y, LightId(0), TriId(t as u32), None));
+                }
+            }
+        }
+        rays
+    }
+
+    /// Brute force's nearest hit of `origin + t dir`, `t > 0`.
+    fn nearest(scene: &Scene, origin: Vec3, dir: Vec3) -> Option<f32> {
+        let test = RayTest::new(origin, dir, 0.0, f32::INFINITY);
+        scene.triangles.iter().filter_map(|t| test.hit(t)).reduce(f32::min)
+    }
+
+    /// A growable stack that records the most entries it held.
+    #[derive(Default)]
+    struct PeakStack {
+        items: Vec<UVec2>,
+        peak: usize,
+    }
+
+    impl FastStack<UVec2> for PeakStack {
+        fn push(&mut self, v: UVec2) {
+            self.items.push(v);
+            self.peak = self.peak.max(self.items.len());
+        }
+        fn pop_fast(&mut self) -> UVec2 {
+            self.items.pop().unwrap()
+        }
+        fn pop(&mut self) -> Option<UVec2> {
+            self.items.pop()
+        }
+        fn len(&self) -> usize {
+            self.items.len()
+        }
+        fn is_empty(&self) -> bool {
+            self.items.is_empty()
+        }
+        fn clear(&mut self) {
+            self.items.clear()
+        }
+    }
+
+    /// Checks every shadow ray and a fan of eye rays of `scene` against brute force; returns the most
+    /// entries a traversal stack held.
+    fn check_against_brute(scene: &Scene, bvh: &Bvh) -> usize {
+        let brute = Brute::new(scene);
+        let mut ctx = QueryCtx::new(scene.triangles.len());
+        let mut peak = PeakStack::default();
+        let mut occluded = 0;
+        let rays = shadow_rays(scene);
+        for (i, ray) in rays.iter().enumerate() {
+            let expected = brute.occluded(ray, &mut ctx);
+            assert_eq!(segment_occluded(scene, bvh, ray, &mut ctx), expected, "shadow ray {i}: {ray:?}");
+            let got = match &bvh.groups {
+                None => segment_occluded_with(&mut peak, &Single, scene, bvh, ray, &mut ctx),
+                Some(g) => segment_occluded_with(&mut peak, g, scene, bvh, ray, &mut ctx),
+            };
+            assert_eq!(got, expected, "shadow ray {i}");
+            occluded += expected as usize;
+        }
+        // Both answers occur, so a traversal that found nothing or everything would fail.
+        assert!(occluded > rays.len() / 10 && occluded < rays.len() * 9 / 10, "{occluded} of {}", rays.len());
+        for i in 0..40 {
+            for j in 0..40 {
+                let origin = Vec3::new(0.3, 5.0, -0.2);
+                let dir = (Vec3::new(i as f32 * 0.11 - 2.2, 0.0, j as f32 * 0.11 - 2.2) - origin).normalize();
+                let expected = nearest(scene, origin, dir);
+                let got = bvh.closest_hit(scene, origin, dir).map(|(_, t)| t);
+                assert_eq!(got, expected, "eye ray {i},{j}");
+                let got = match &bvh.groups {
+                    None => bvh.closest_hit_with(&mut peak, &Single, scene, origin, dir, 0.0, None),
+                    Some(g) => bvh.closest_hit_with(&mut peak, g, scene, origin, dir, 0.0, None),
+                };
+                let got = got.map(|(_, t)| t);
+                assert_eq!(got, expected, "eye ray {i},{j}");
+            }
+        }
+        peak.peak
+    }
+
+    /// 2,000 copies of a triangle, each 1e-4 wider than the last: distinct boxes around one centre,
+    /// which PLOC stacks into a BVH deeper than obvhs' fixed stack holds. (Built without grouping
+    /// crowded centres, which would make them one primitive.)
+    #[test]
+    fn deep_bvh_answers_every_ray_as_brute_force() {
+        let scene = scene_with_copies(2000, 1e-4);
+        let bvh = Bvh::build_ungrouped(&scene);
+        // Deeper than obvhs' fixed stack holds: the growable stack is the one used.
+        assert!(bvh.depth() as usize >= FIXED_STACK, "depth {}", bvh.depth());
+        assert!(!bvh.fixed_stack_fits());
+        let peak = check_against_brute(&scene, &bvh);
+        eprintln!("deep BVH: depth {}, at most {peak} stack entries", bvh.depth());
+        // The bound the choice of stack relies on.
+        assert!(peak <= bvh.depth() as usize, "peak {peak} > depth {}", bvh.depth());
+    }
+
+    /// 400 exact copies (the 1,200-index face), and 2,000 triangles nested around one centre:
+    /// one primitive lists them all, and the BVH is shallow (without the grouping it was deeper than
+    /// the fixed stack, and PLOC's build quadratic).
+    #[test]
+    fn crowded_centres_are_one_primitive() {
+        for (copies, grow) in [(400, 0.0), (2000, 1e-4)] {
+            let scene = scene_with_copies(copies, grow);
+            let bvh = Bvh::build(&scene);
+            // The copies' centres fall in one cell, or a few where rounding straddles a cell's side.
+            let others = scene.triangles.len() - copies;
+            let prims = bvh.primitive_count();
+            assert!(prims > others && prims <= others + 4, "{copies} copies: {prims} primitives");
+            assert!(bvh.fixed_stack_fits(), "{copies} copies: depth {}", bvh.depth());
+            let peak = check_against_brute(&scene, &bvh);
+            assert!(peak <= bvh.depth() as usize, "peak {peak} > depth {}", bvh.depth());
+        }
+    }
+
+    /// Up to [`CROWD_LIMIT`] triangles sharing a box stay one primitive each.
+    #[test]
+    fn a_few_copies_stay_apart() {
+        let scene = scene_with_copies(CROWD_LIMIT, 0.0);
+        let bvh = Bvh::build(&scene);
+        assert_eq!(bvh.primitive_count(), scene.triangles.len());
+        check_against_brute(&scene, &bvh);
+    }
+
+    #[test]
+    fn shallow_bvh_keeps_the_fixed_stack() {
+        let scene = scene_with_copies(1, 0.0);
+        let bvh = Bvh::build(&scene);
+        assert!(bvh.fixed_stack_fits(), "depth {}", bvh.depth());
+        let peak = check_against_brute(&scene, &bvh);
+        assert!(peak <= bvh.depth() as usize, "peak {peak} > depth {}", bvh.depth());
+    }
+
+    #[test]
+    fn depth_of_an_empty_and_a_one_box_bvh() {
+        assert_eq!(inner_depth(&CwBvh::default()), 0);
+        let one = build_cwbvh(&[BAabb::new(Vec3A::ZERO, Vec3A::ONE)], BvhBuildParams::medium_build());
+        assert_eq!(inner_depth(&one), 0);
+    }
 }
