@@ -20,7 +20,7 @@ use glam::Vec3;
 
 use super::query::SEGMENT_EPS;
 use super::{LightRays, QueryCtx, ShadowRay};
-use crate::geometry::Aabb;
+use crate::geometry::{Aabb, Triangle};
 use crate::scene::{Scene, TriId};
 
 pub use super::pyramid::Pyramid;
@@ -215,18 +215,33 @@ impl Fan {
         let w = self.open.len();
         let tri = &scene.triangles[t.idx()];
         for i in 0..w {
-            let mut bits = self.masks[level * w + i] & self.open[i];
-            while bits != 0 {
-                let j = i * 64 + bits.trailing_zeros() as usize;
-                bits &= bits - 1;
-                let k = self.idx[j] as usize;
-                let ray = *self.rays[k].get_or_insert_with(|| rays.ray(k));
-                ctx.stats.triangle_tests += 1;
-                if ray.test.hit(tri).is_some() {
-                    self.open[i] &= !(1u64 << (j % 64));
-                    self.live -= 1;
-                    out[k] = true;
-                }
+            let bits = self.masks[level * w + i] & self.open[i];
+            self.exact(tri, i, bits, rays, out, ctx);
+        }
+    }
+
+    /// The watertight test of `tri` for the active lanes `bits` of word `w`: each ray it blocks gets
+    /// `out[k]` set and is closed.
+    #[inline]
+    fn exact(
+        &mut self,
+        tri: &Triangle,
+        w: usize,
+        mut bits: u64,
+        rays: &LightRays,
+        out: &mut [bool],
+        ctx: &mut QueryCtx,
+    ) {
+        while bits != 0 {
+            let j = w * 64 + bits.trailing_zeros() as usize;
+            bits &= bits - 1;
+            let k = self.idx[j] as usize;
+            let ray = *self.rays[k].get_or_insert_with(|| rays.ray(k));
+            ctx.stats.triangle_tests += 1;
+            if ray.test.hit(tri).is_some() {
+                self.open[w] &= !(1u64 << (j % 64));
+                self.live -= 1;
+                out[k] = true;
             }
         }
     }
@@ -268,19 +283,8 @@ impl Fan {
             self.maybe.fill(u64::MAX);
         }
         for w in 0..self.open.len() {
-            let mut bits = self.maybe[w] & self.open[w];
-            while bits != 0 {
-                let j = w * 64 + bits.trailing_zeros() as usize;
-                bits &= bits - 1;
-                let k = self.idx[j] as usize;
-                let ray = *self.rays[k].get_or_insert_with(|| rays.ray(k));
-                ctx.stats.triangle_tests += 1;
-                if ray.test.hit(tri).is_some() {
-                    self.open[w] &= !(1u64 << (j % 64));
-                    self.live -= 1;
-                    out[k] = true;
-                }
-            }
+            let bits = self.maybe[w] & self.open[w];
+            self.exact(tri, w, bits, rays, out, ctx);
         }
     }
 }
