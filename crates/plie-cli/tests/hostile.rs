@@ -319,31 +319,46 @@ fn scene_files_cannot_name_files_outside_their_folder() {
     assert!(o.status.success(), "{}", stderr(&o));
 }
 
-/// glTF image URIs are never opened (plie reads no textures): an image naming a FIFO outside the
-/// scene's folder, which would block a reader forever, leaves the render unaffected.
+/// glTF image URIs are read since textures are (issue 18), within the same rules: a FIFO (which
+/// would block a reader forever), a device or a file outside the scene's folder is a one-line error
+/// naming the image, never a hang, and a FIFO inside the folder is refused as not a regular file.
 #[test]
-fn gltf_image_uris_are_never_opened() {
+fn hostile_gltf_image_uris_are_clean_errors() {
+    let dir = tempfile::tempdir().unwrap();
     let elsewhere = tempfile::tempdir().unwrap();
-    let fifo = elsewhere.path().join("fifo.png");
-    match Command::new("mkfifo").arg(&fifo).status() {
-        Ok(st) if st.success() => {}
-        _ => {
-            eprintln!("notice: no mkfifo; skipping");
-            return;
+    let (inside, outside) = (dir.path().join("fifo.png"), elsewhere.path().join("fifo.png"));
+    for f in [&inside, &outside] {
+        match Command::new("mkfifo").arg(f).status() {
+            Ok(st) if st.success() => {}
+            _ => {
+                eprintln!("notice: no mkfifo; skipping");
+                return;
+            }
         }
     }
     let seed = Path::new(env!("CARGO_MANIFEST_DIR")).join("../plie/tests/fuzz/seeds/embedded.gltf");
-    let mut g: serde_json::Value = serde_json::from_slice(&std::fs::read(seed).unwrap()).unwrap();
-    g["images"] = serde_json::json!([{"uri": s(&fifo)}, {"uri": "../../../../etc/passwd"}, {"uri": "/dev/zero"}]);
-    g["textures"] = serde_json::json!([{"source": 0}, {"source": 1}, {"source": 2}]);
-    g["materials"][0]["pbrMetallicRoughness"]["baseColorTexture"] = serde_json::json!({"index": 0});
-    let dir = tempfile::tempdir().unwrap();
-    let scene = write(dir.path(), "tex.gltf", serde_json::to_vec(&g).unwrap());
-    let out = dir.path().join("o.png");
-    let args = ["render", "--scene", s(&scene), "-o", s(&out), "--width", "8", "--height", "8"];
-    let (o, in_time) = plie_bounded(&args, 2048, Duration::from_secs(30));
-    assert!(in_time, "killed after 30 s: an image URI was opened");
-    assert!(o.status.success(), "{}", stderr(&o));
+    let base: serde_json::Value = serde_json::from_slice(&std::fs::read(seed).unwrap()).unwrap();
+    let cases = [
+        (s(&outside), "outside the scene's folder"),
+        ("../../../../etc/passwd", "outside the scene's folder"),
+        ("/dev/zero", "outside the scene's folder"),
+        ("fifo.png", "not a regular file"),
+    ];
+    for (uri, why) in cases {
+        let mut g = base.clone();
+        g["images"] = serde_json::json!([{ "uri": uri }]);
+        g["textures"] = serde_json::json!([{"source": 0}]);
+        g["materials"][0]["pbrMetallicRoughness"]["baseColorTexture"] = serde_json::json!({"index": 0});
+        let scene = write(dir.path(), "tex.gltf", serde_json::to_vec(&g).unwrap());
+        let before = std::fs::read(&scene).unwrap();
+        let out = dir.path().join("o.png");
+        let args = ["render", "--scene", s(&scene), "-o", s(&out), "--width", "8", "--height", "8"];
+        let (o, in_time) = plie_bounded(&args, 2048, Duration::from_secs(30));
+        assert!(in_time, "{uri}: killed after 30 s");
+        one_line_error(&o, &["tex.gltf", "image 0", why]);
+        assert_eq!(std::fs::read(&scene).unwrap(), before, "the input is unchanged");
+        assert!(!out.exists(), "{uri}: no image written");
+    }
 }
 
 // 6. Unbounded --threads.

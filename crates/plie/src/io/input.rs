@@ -28,6 +28,13 @@ pub struct LoadOptions {
 /// Opens `path` for reading if it is a regular file no larger than `limit` bytes.
 pub fn open_regular(path: &Path, limit: u64) -> Result<File> {
     let io = |source| Error::Io { path: path.to_path_buf(), source };
+    // Without blocking: opening a FIFO for reading would otherwise wait for a writer forever.
+    #[cfg(unix)]
+    let file = {
+        use std::os::unix::fs::OpenOptionsExt;
+        std::fs::OpenOptions::new().read(true).custom_flags(libc::O_NONBLOCK).open(path).map_err(io)?
+    };
+    #[cfg(not(unix))]
     let file = File::open(path).map_err(io)?;
     let meta = file.metadata().map_err(io)?;
     if !meta.is_file() {
