@@ -55,16 +55,16 @@ impl Levels {
 
 impl ListBoxes {
     /// The hierarchies of the lists `ranges` (start, len) of `refs`. Ranges may repeat (grid cells
-    /// share lists): a repeated range shares its boxes.
+    /// share lists): a repeated range (same start and length) shares its boxes.
     pub fn new(ranges: impl Iterator<Item = (u32, u32)>, refs: &[TriId], tri_boxes: &[Aabb]) -> ListBoxes {
         let mut out = ListBoxes::default();
-        let mut seen: std::collections::HashMap<u32, u32> = std::collections::HashMap::new();
+        let mut seen: std::collections::HashMap<(u32, u32), u32> = std::collections::HashMap::new();
         for (start, len) in ranges {
             if (len as usize) < CHUNKED_MIN || start == u32::MAX {
                 out.first.push(u32::MAX);
                 continue;
             }
-            let f = *seen.entry(start).or_insert_with(|| {
+            let f = *seen.entry((start, len)).or_insert_with(|| {
                 let f = out.boxes.len();
                 let union = |it: &mut dyn Iterator<Item = Aabb>| it.reduce(Aabb::union).expect("not empty");
                 for chunk in refs[start as usize..(start + len) as usize].chunks(CHUNK) {
