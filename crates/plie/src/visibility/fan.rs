@@ -110,9 +110,9 @@ impl Fan {
         self.live = 0;
     }
 
-    /// Makes the rays `k` with `want(k)` the active ones.
-    pub fn select(&mut self, want: impl Fn(usize) -> bool) {
-        for v in [
+    /// The active rays' per-lane `f32` arrays.
+    fn float_lanes(&mut self) -> [&mut Vec<f32>; 8] {
+        [
             &mut self.ax,
             &mut self.ay,
             &mut self.az,
@@ -121,7 +121,12 @@ impl Fan {
             &mut self.aix,
             &mut self.aiy,
             &mut self.aiz,
-        ] {
+        ]
+    }
+
+    /// Makes the rays `k` with `want(k)` the active ones.
+    pub fn select(&mut self, want: impl Fn(usize) -> bool) {
+        for v in self.float_lanes() {
             v.clear();
         }
         self.idx.clear();
@@ -144,16 +149,7 @@ impl Fan {
         }
         let m = self.idx.len();
         let padded = m.div_ceil(LANES) * LANES;
-        for v in [
-            &mut self.ax,
-            &mut self.ay,
-            &mut self.az,
-            &mut self.al,
-            &mut self.asz,
-            &mut self.aix,
-            &mut self.aiy,
-            &mut self.aiz,
-        ] {
+        for v in self.float_lanes() {
             v.resize(padded, 0.0);
         }
         self.akz.resize(padded, 0);
