@@ -12,14 +12,14 @@ use std::time::Instant;
 
 use anyhow::{Context, Result};
 use plie::construct::refine::RefineParams;
-use plie::lie::{Grids, Plie, PlieParams, Propagation, Regions};
+use plie::lie::{Grids, PlieParams, Propagation, Regions};
 use plie::octree::Octree;
 use plie::render::shade::shade;
 use plie::render::{HitBuffer, NoProgress, Progress};
 use plie::scene::builtin;
 use plie::visibility::bvh::Bvh;
 use plie::visibility::{self, Mode};
-use plie::{Camera, Scene};
+use plie::{Camera, Environment, Scene, Shadows};
 
 use crate::bench_data::{median, BreakEven, BuildResult, Plan, Results, SceneResult, Shading};
 use crate::progress::Bar;
@@ -177,18 +177,25 @@ fn timed<T>(runs: usize, mut f: impl FnMut() -> T) -> (T, f64) {
     (last.expect("at least one run"), median(&mut times))
 }
 
+/// Builds the environment `runs` times; `seconds` is the median construction time (the octree built
+/// first is timed apart, as `octree_seconds`).
 fn build_plie(
     scene: &Scene,
-    octree: &Octree,
     params: PlieParams,
     config: &'static str,
     runs: usize,
-) -> (Octree, Plie, BuildResult) {
-    let (b, seconds) = timed(runs, || plie::construct::build_refined(scene, octree.clone(), params, &NoProgress));
-    let s = b.stats;
+) -> Result<(Environment, BuildResult)> {
+    let mut times = Vec::with_capacity(runs);
+    let mut last = None;
+    for _ in 0..runs.max(1) {
+        let (env, stats) = Environment::build(scene, &params)?;
+        times.push(stats.blockers_seconds);
+        last = Some((env, stats));
+    }
+    let (env, s) = last.expect("at least one run");
     let r = BuildResult {
         config,
-        seconds,
+        seconds: median(&mut times),
         leaves: s.leaves,
         records: s.records,
         records_removed_umbra: s.records_removed_umbra,
@@ -196,7 +203,7 @@ fn build_plie(
         blockers_mean: s.blockers_mean,
         blockers_max: s.blockers_max,
     };
-    (b.octree, b.plie, r)
+    Ok((env, r))
 }
 
 fn bench_scene(name: &str, plan: &Plan, one: &rayon::ThreadPool, bar: &Bar) -> Result<SceneResult> {
@@ -207,19 +214,20 @@ fn bench_scene(name: &str, plan: &Plan, one: &rayon::ThreadPool, bar: &Bar) -> R
     thesis.octree().validate()?;
     let (octree, octree_seconds) =
         timed(plan.runs, || Octree::build(&scene, thesis.octree()).expect("valid octree parameters"));
-    let (_, lie, b1) = build_plie(&scene, &octree, thesis, "thesis", plan.runs);
-    let (_, grid, b2) = build_plie(&scene, &octree, PlieParams::default().bounded(), "grids", plan.runs);
+    let (lie, b1) = build_plie(&scene, thesis, "thesis", plan.runs)?;
+    let (grid, b2) = build_plie(&scene, PlieParams::default().bounded(), "grids", plan.runs)?;
     let no_regions = PlieParams { regions: Regions::Skip, ..thesis };
-    let (_, _, b3) = build_plie(&scene, &octree, no_regions, "blockers-only", plan.runs);
+    let (_, b3) = build_plie(&scene, no_regions, "blockers-only", plan.runs)?;
     let no_propagation = PlieParams { propagation: Propagation::Off, ..thesis };
-    let (_, _, b4) = build_plie(&scene, &octree, no_propagation, "no-propagation", plan.runs);
+    let (_, b4) = build_plie(&scene, no_propagation, "no-propagation", plan.runs)?;
     let refined = PlieParams { refine: RefineParams::thesis_umbra(), ..thesis };
-    let (r_octree, r_lie, b5) = build_plie(&scene, &octree, refined, "refined", plan.runs);
-    let (_, r_grid, b6) =
-        build_plie(&scene, &octree, PlieParams { grids: Grids::Build, ..refined }, "refined-grids", plan.runs);
+    let (r_lie, b5) = build_plie(&scene, refined, "refined", plan.runs)?;
+    let (r_grid, b6) = build_plie(&scene, PlieParams { grids: Grids::Build, ..refined }, "refined-grids", plan.runs)?;
+    let r_octree = r_lie.octree();
     bar.advance(1);
-    let s = Structures { scene: &scene, bvh: &bvh, octree: &octree, lie: &lie, grid: &grid };
-    let r = Structures { scene: &scene, bvh: &bvh, octree: &r_octree, lie: &r_lie, grid: &r_grid };
+    let shadows = Shadows::with_octree_params(&scene, thesis.octree())?;
+    let s = Structures { scene: &scene, shadows: &shadows, lie: &lie, grid: &grid };
+    let r = Structures { scene: &scene, shadows: &shadows, lie: &r_lie, grid: &r_grid };
     let mut shading = Vec::new();
     let mut single = Vec::new();
     for &size in &plan.sizes {
@@ -236,7 +244,7 @@ fn bench_scene(name: &str, plan: &Plan, one: &rayon::ThreadPool, bar: &Bar) -> R
             }
         }
         // The refined octree has other leaves: its own hit buffer (the same points and normals).
-        let hits = HitBuffer::build(&scene, &camera, (size, size, 1), &bvh, Some(&r_octree));
+        let hits = HitBuffer::build(&scene, &camera, (size, size, 1), &bvh, Some(r_octree));
         for &mode in &plan.refined_modes {
             let vis = r.visibility(mode)?;
             for &n in &plan.shadow_rays {
@@ -265,18 +273,21 @@ fn bench_scene(name: &str, plan: &Plan, one: &rayon::ThreadPool, bar: &Bar) -> R
 /// The structures of one scene, from which every mode's visibility is made.
 struct Structures<'a> {
     scene: &'a Scene,
-    bvh: &'a Bvh,
-    octree: &'a Octree,
+    /// The modes without a P-LIE.
+    shadows: &'a Shadows<'a>,
     /// Built with the thesis' parameters (mode lie).
-    lie: &'a Plie,
+    lie: &'a Environment,
     /// Built with face grids (mode grid).
-    grid: &'a Plie,
+    grid: &'a Environment,
 }
 
 impl<'a> Structures<'a> {
     fn visibility(&self, mode: Mode) -> Result<Box<dyn visibility::Visibility + 'a>> {
-        let plie = if mode == Mode::Grid { self.grid } else { self.lie };
-        Ok(visibility::for_mode(mode, self.scene, self.bvh, self.octree, Some(plie))?)
+        if !mode.needs_plie() {
+            return Ok(self.shadows.visibility(mode)?);
+        }
+        let env = if mode == Mode::Grid { self.grid } else { self.lie };
+        Ok(env.visibility(mode, self.scene)?)
     }
 }
 

@@ -12,12 +12,10 @@ use std::path::Path;
 
 use anyhow::{Context, Result};
 use plie::lie::PlieParams;
-use plie::octree::Octree;
-use plie::render::path::{render_path, Nee, PathSettings};
-use plie::render::{NoProgress, Progress, RenderSettings};
-use plie::visibility::bvh::Bvh;
-use plie::visibility::{self, Mode};
-use plie::Camera;
+use plie::render::path::{Nee, PathSettings};
+use plie::render::{Progress, RenderSettings};
+use plie::visibility::Mode;
+use plie::{Camera, Environment, Integrator, Renderer, Shadows, Timing};
 use serde::Serialize;
 
 use crate::progress::Bar;
@@ -75,22 +73,19 @@ pub fn run(plan: &PathPlan, out: &Path, bar: &Bar) -> Result<()> {
         let args = SceneArgs { scene: name.clone(), allow_outside_paths: false };
         let scene = args.load().with_context(|| format!("scene {name}"))?;
         let camera: Camera = CameraArgs { eye, target, up: None, fov }.camera(&scene)?;
-        let bvh = Bvh::build(&scene);
         let params = PlieParams::default();
-        let octree = Octree::build(&scene, params.octree())?;
+        let shadows = Shadows::with_octree_params(&scene, params.octree())?;
         let t = std::time::Instant::now();
-        let grid = modes
-            .iter()
-            .any(|m| m.needs_plie())
-            .then(|| plie::construct::build_refined(&scene, octree.clone(), params, &NoProgress));
-        let build_seconds = grid.as_ref().map(|_| t.elapsed().as_secs_f64());
-        let (oc, plie) = match &grid {
-            Some(b) => (&b.octree, Some(&b.plie)),
-            None => (&octree, None),
-        };
+        let env = modes.iter().any(|m| m.needs_plie()).then(|| Environment::build(&scene, &params)).transpose()?;
+        let build_seconds = env.as_ref().map(|_| t.elapsed().as_secs_f64());
+        let oc = env.as_ref().map_or_else(|| shadows.octree(), |(e, _)| e.octree());
+        let bvh = shadows.bvh();
         for &depth in &plan.depths {
             for &mode in &modes {
-                let vis = visibility::for_mode(mode, &scene, &bvh, oc, plie)?;
+                let vis = match &env {
+                    Some((e, _)) if mode.needs_plie() => e.visibility(mode, &scene)?,
+                    _ => shadows.visibility(mode)?,
+                };
                 let settings = RenderSettings {
                     width: plan.size,
                     height: plan.size,
@@ -100,33 +95,28 @@ pub fn run(plan: &PathPlan, out: &Path, bar: &Bar) -> Result<()> {
                 };
                 let path = PathSettings { spp: plan.spp, max_depth: depth, rr_depth: None, nee: Nee::Power };
                 let located = mode.needs_plie().then_some(oc);
+                let renderer = Renderer::new().settings(settings).camera(camera).integrator(Integrator::Path(path));
                 let mut runs = Vec::new();
                 for _ in 0..plan.runs {
-                    runs.push(render_path(
-                        &scene,
-                        &camera,
-                        &settings,
-                        &path,
-                        &bvh,
-                        located,
-                        vis.as_ref(),
-                        &NoProgress,
-                    )?);
+                    let image = renderer.render_with(&scene, bvh, located, vis.as_ref())?;
+                    let Timing::Path { seconds, path } = image.timing else {
+                        anyhow::bail!("the path tracer rendered without its timings");
+                    };
+                    runs.push((seconds, path, image.stats));
                 }
-                runs.sort_by(|a, b| a.seconds.total_cmp(&b.seconds));
-                let r = &runs[runs.len() / 2];
-                let p = &r.path;
+                runs.sort_by(|a, b| a.0.total_cmp(&b.0));
+                let (seconds, p, stats) = &runs[runs.len() / 2];
                 rows.push(PathRow {
                     scene: scene.name.clone(),
                     triangles: scene.triangle_count(),
                     mode,
                     max_depth: depth,
-                    total_seconds: r.seconds,
+                    total_seconds: *seconds,
                     thread_seconds: p.thread_seconds,
                     shadow_seconds: p.shadow_seconds,
                     shadow_share: p.shadow_seconds / p.thread_seconds.max(1e-9),
-                    shadow_rays: r.stats.shadow_rays,
-                    mrays_per_second: r.stats.shadow_rays as f64 / p.shadow_seconds.max(1e-9) / 1e6,
+                    shadow_rays: stats.shadow_rays,
+                    mrays_per_second: stats.shadow_rays as f64 / p.shadow_seconds.max(1e-9) / 1e6,
                     bounce_rays: p.bounce_rays,
                     locates: p.locates,
                     locate_ns: 1e9 * p.locate_seconds / p.locates.max(1) as f64,

@@ -13,14 +13,12 @@ use std::time::Instant;
 use anyhow::{Context, Result};
 use plie::construct::refine::RefineParams;
 use plie::lie::PlieParams;
-use plie::octree::Octree;
 use plie::render::cpu_time::process_cpu_seconds;
 use plie::render::shade::shade;
 use plie::render::{HitBuffer, NoProgress};
 use plie::scene::builtin;
-use plie::visibility::bvh::Bvh;
-use plie::visibility::{self, LightAnswers, Mode, QueryCtx, ShadowRay, Visibility};
-use plie::{Camera, Scene};
+use plie::visibility::{LightAnswers, Mode, QueryCtx, ShadowRay, Visibility};
+use plie::{Camera, Environment, Scene, Shadows};
 use serde::Serialize;
 
 /// Image size (width = height) of the table.
@@ -136,25 +134,21 @@ pub fn run(scenes: &[String], out: &Path, runs: usize, quiet: bool) -> Result<()
         if !quiet {
             eprintln!("soft shadows: {label} ({} triangles)", scene.triangle_count());
         }
-        let bvh = Bvh::build(&scene);
         let params = PlieParams::default();
-        let octree = Octree::build(&scene, params.octree())?;
-        let plie = plie::construct::build_refined(&scene, octree.clone(), params, &NoProgress).plie;
+        let (env, _) = Environment::build(&scene, &params)?;
         let refine = RefineParams { umbra_full: true, umbra_free: true, ..RefineParams::none() };
-        let refined =
-            plie::construct::build_refined(&scene, octree.clone(), PlieParams { refine, ..params }, &NoProgress);
-        let hits = HitBuffer::build(&scene, &camera, (SIZE, SIZE, 1), &bvh, Some(&octree));
-        let r_hits = HitBuffer::build(&scene, &camera, (SIZE, SIZE, 1), &bvh, Some(&refined.octree));
+        let (refined, _) = Environment::build(&scene, &PlieParams { refine, ..params })?;
+        let shadows = Shadows::new(&scene);
+        let bvh = shadows.bvh();
+        let hits = HitBuffer::build(&scene, &camera, (SIZE, SIZE, 1), bvh, Some(env.octree()));
+        let r_hits = HitBuffer::build(&scene, &camera, (SIZE, SIZE, 1), bvh, Some(refined.octree()));
         for n in SHADOW_RAYS {
             for col in columns() {
                 let (vis, hits): (Box<dyn Visibility + '_>, _) = match col {
-                    Column::Mode(m) => (visibility::for_mode(m, &scene, &bvh, &octree, Some(&plie))?, &hits),
-                    Column::Refined(m) => {
-                        (visibility::for_mode(m, &scene, &bvh, &refined.octree, Some(&refined.plie))?, &r_hits)
-                    }
-                    Column::PerRay(m) => {
-                        (Box::new(PerRay(visibility::for_mode(m, &scene, &bvh, &octree, Some(&plie))?)), &hits)
-                    }
+                    Column::Mode(m) if !m.needs_plie() => (shadows.visibility(m)?, &hits),
+                    Column::Mode(m) => (env.visibility(m, &scene)?, &hits),
+                    Column::Refined(m) => (refined.visibility(m, &scene)?, &r_hits),
+                    Column::PerRay(m) => (Box::new(PerRay(env.visibility(m, &scene)?)), &hits),
                 };
                 let (mut walls, mut cpus) = (Vec::new(), Vec::new());
                 let mut last = None;
@@ -169,7 +163,7 @@ pub fn run(scenes: &[String], out: &Path, runs: usize, quiet: bool) -> Result<()
                 let stats = last.expect("one run");
                 let differing = match col {
                     Column::Mode(m) if m != Mode::None && !m.is_exact() => {
-                        let bvh_vis = visibility::for_mode(Mode::Bvh, &scene, &bvh, &octree, None)?;
+                        let bvh_vis = shadows.visibility(Mode::Bvh)?;
                         Some(plie::compare::answer_diff(&scene, hits, vis.as_ref(), bvh_vis.as_ref(), n, 1).differing)
                     }
                     _ => None,

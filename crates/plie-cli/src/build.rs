@@ -5,7 +5,7 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use anyhow::{Context, Result};
-use plie::octree::Octree;
+use plie::{BuildOptions, Environment};
 use serde_json::json;
 
 use crate::plie_args::PlieArgs;
@@ -50,22 +50,23 @@ pub fn run(a: &Args) -> Result<()> {
     let params = a.params.params(true)?;
     let budget = a.memory_budget.unwrap_or_else(crate::budget::default_bytes);
     crate::budget::check(budget, &scene)?;
-    let limits = plie::construct::Limits { list_bytes: Some(crate::budget::list_bytes(budget, &scene)) };
+    let list_budget = Some(crate::budget::list_bytes(budget, &scene));
     let bar = Bar::new(a.quiet || a.json);
     let t_all = Instant::now();
-    let t = Instant::now();
-    let octree = Octree::build(&scene, params.octree())?;
-    let octree_seconds = t.elapsed().as_secs_f64();
-    let built = plie::construct::build_bounded(&scene, octree, params, limits, &bar)
-        .context("P-LIE construction stopped by Ctrl-C; nothing was written")?;
-    crate::budget::warn_over(&built.stats, &bar);
-    let (octree, plie, mut stats) = (built.octree, built.plie, built.stats);
-    stats.octree_seconds = octree_seconds;
+    let options = BuildOptions { list_bytes: list_budget, progress: &bar };
+    let (env, stats) = match Environment::build_with(&scene, &params, options) {
+        Err(e @ plie::Error::Interrupted) => {
+            return Err(anyhow::Error::new(e).context("P-LIE construction stopped by Ctrl-C; nothing was written"))
+        }
+        built => built?,
+    };
+    crate::budget::warn_over(&stats, &bar);
+    let octree_seconds = stats.octree_seconds;
     let build_seconds = t_all.elapsed().as_secs_f64();
     let t = Instant::now();
-    let file_bytes = plie::io::plie_file::save_plie(&a.output, &scene, &octree, &plie)
-        .with_context(|| format!("cannot write {}", a.output.display()))?;
+    let file_bytes = env.save(&a.output, &scene).with_context(|| format!("cannot write {}", a.output.display()))?;
     let write_seconds = t.elapsed().as_secs_f64();
+    let (octree, plie) = (env.octree(), env.plie());
     let peak = crate::budget::peak_bytes();
     let memory = plie.memory_bytes() + octree.memory_bytes();
     if a.json {
@@ -95,7 +96,7 @@ pub fn run(a: &Args) -> Result<()> {
             "records_over_budget": stats.records_over_budget,
             "list_bytes": stats.list_bytes,
             "memory_budget": budget,
-            "list_budget": limits.list_bytes,
+            "list_budget": list_budget,
             "peak_memory_bytes": peak,
         });
         let mut v = json!({

@@ -15,7 +15,7 @@ use plie::octree::{Dir, Octree};
 use serde_json::{json, Value};
 
 use crate::image_args::ImageArgs;
-use crate::plie_args::{load_file, load_or_build, Loaded, PlieArgs};
+use crate::plie_args::{build, load_file, Loaded, PlieArgs};
 use crate::progress::Bar;
 use crate::scene_arg::{parse_vec3, CameraArgs, SceneArgs};
 
@@ -117,11 +117,12 @@ pub fn run(a: &Args, matches: &clap::ArgMatches) -> Result<()> {
     a.image.size_for(&mut settings, &scene)?;
     let params = a.params.params(false)?;
     let bar = Bar::new(a.quiet || a.json);
-    let Loaded { octree, plie, .. } = match a.plie.as_deref() {
+    let Loaded { env, .. } = match a.plie.as_deref() {
         Some(file) => load_file(&scene, file, &a.params, matches)?,
-        None => load_or_build(&scene, params, None, &bar)?,
+        None => build(&scene, params, &bar)?,
     };
-    let inspector = Inspector::new(&scene, &octree, &plie)?;
+    let (octree, plie) = (env.octree(), env.plie());
+    let inspector = Inspector::new(&scene, octree, plie)?;
     let light = a.light.map(|i| inspector.light(i)).transpose()?;
     let leaf = a.cell.map(|p| inspector.leaf_at(p)).transpose()?;
     let inspection = match a.cell.filter(|_| a.output.is_some()) {
@@ -135,19 +136,19 @@ pub fn run(a: &Args, matches: &clap::ArgMatches) -> Result<()> {
 
     if let (Some(ins), Some(path), Some(kind)) = (&inspection, &a.output, kind) {
         if !a.quiet && !a.json {
-            describe(&octree, ins, plie.params.has_regions());
+            describe(octree, ins, plie.params.has_regions());
         }
         let camera = if a.frame { camera_on_box(&camera, &ins.bounds) } else { camera };
         match kind {
             Output::Png => {
                 let style = OverlayStyle { line_px: a.line_width, exposure_ev: a.image.exposure };
-                let out = render_inspection(&scene, &octree, ins, &camera, &settings, &style, &bar)?;
+                let out = render_inspection(&scene, octree, ins, &camera, &settings, &style, &bar)?;
                 plie::io::save_image(path, settings.width, settings.height, &out.pixels)
                     .with_context(|| format!("cannot write {}", path.display()))?;
             }
             Output::Gltf => {
                 let aspect = settings.width as f32 / settings.height as f32;
-                save_inspection_gltf(path, &scene, &octree, ins, Some((&camera, aspect)))
+                save_inspection_gltf(path, &scene, octree, ins, Some((&camera, aspect)))
                     .with_context(|| format!("cannot write {}", path.display()))?;
             }
         }
@@ -161,7 +162,7 @@ pub fn run(a: &Args, matches: &clap::ArgMatches) -> Result<()> {
             v["summary"] = serde_json::to_value(s)?;
         }
         if let (Some(ins), Some(path)) = (&inspection, &a.output) {
-            v["inspection"] = inspection_json(&octree, ins, plie.params.has_regions());
+            v["inspection"] = inspection_json(octree, ins, plie.params.has_regions());
             v["output"] = json!(path.display().to_string());
         }
         println!("{v}");

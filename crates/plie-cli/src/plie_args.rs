@@ -9,10 +9,10 @@ use anyhow::{bail, Context, Result};
 use clap::parser::ValueSource;
 use clap::ArgMatches;
 use plie::construct::refine::{MaxBlockers, RefineParams};
-use plie::lie::Plie;
 use plie::lie::{Grids, PlieParams, Propagation, Regions};
-use plie::octree::{Octree, OctreeParams};
+use plie::octree::OctreeParams;
 use plie::Scene;
+use plie::{BuildOptions, Environment};
 
 use crate::progress::Bar;
 
@@ -239,43 +239,27 @@ impl PlieArgs {
 /// built with, after checking them against the options given explicitly ([`PlieArgs::check_file_params`]).
 pub fn load_file(scene: &Scene, path: &Path, args: &PlieArgs, matches: &ArgMatches) -> Result<Loaded> {
     let t = Instant::now();
-    let (octree, plie) = plie::io::plie_file::load_plie(path, scene, None)
-        .with_context(|| format!("cannot use P-LIE file {}", path.display()))?;
-    args.check_file_params(&plie.params, matches, path)?;
-    Ok(Loaded { octree, plie, build_seconds: None, load_seconds: Some(t.elapsed().as_secs_f64()) })
+    let env =
+        Environment::load(path, scene, None).with_context(|| format!("cannot use P-LIE file {}", path.display()))?;
+    args.check_file_params(env.params(), matches, path)?;
+    Ok(Loaded { env, build_seconds: None, load_seconds: Some(t.elapsed().as_secs_f64()) })
 }
 
-/// An octree and its P-LIE, loaded from a file or built.
+/// A P-LIE environment (octree and P-LIE), loaded from a file or built.
 pub struct Loaded {
-    /// The octree (refined if the P-LIE was).
-    pub octree: Octree,
-    /// The P-LIE.
-    pub plie: Plie,
+    /// The octree (refined if the P-LIE was) and the P-LIE.
+    pub env: Environment,
     /// Seconds building the P-LIE (octree excluded), when built.
     pub build_seconds: Option<f64>,
     /// Seconds loading the file (octree rebuilt included), when loaded.
     pub load_seconds: Option<f64>,
 }
 
-/// Loads the P-LIE file `path` (checking it was built for `scene` with `params`), or builds the
-/// octree and the P-LIE (refined if `params` asks) when there is no file.
-pub fn load_or_build(scene: &Scene, params: PlieParams, path: Option<&Path>, bar: &Bar) -> Result<Loaded> {
-    let t = Instant::now();
-    if let Some(path) = path {
-        let (octree, plie) = plie::io::plie_file::load_plie(path, scene, Some(params))
-            .with_context(|| format!("cannot use P-LIE file {}", path.display()))?;
-        return Ok(Loaded { octree, plie, build_seconds: None, load_seconds: Some(t.elapsed().as_secs_f64()) });
-    }
-    let octree = Octree::build(scene, params.octree())?;
-    let t = Instant::now();
-    let limits =
-        plie::construct::Limits { list_bytes: Some(crate::budget::list_bytes(crate::budget::default_bytes(), scene)) };
-    let built = plie::construct::build_bounded(scene, octree, params, limits, bar)?;
-    crate::budget::warn_over(&built.stats, bar);
-    Ok(Loaded {
-        octree: built.octree,
-        plie: built.plie,
-        build_seconds: Some(t.elapsed().as_secs_f64()),
-        load_seconds: None,
-    })
+/// Builds the octree and the P-LIE of `scene` (refined if `params` asks) within the default memory
+/// budget.
+pub fn build(scene: &Scene, params: PlieParams, bar: &Bar) -> Result<Loaded> {
+    let list_bytes = Some(crate::budget::list_bytes(crate::budget::default_bytes(), scene));
+    let (env, stats) = Environment::build_with(scene, &params, BuildOptions { list_bytes, progress: bar })?;
+    crate::budget::warn_over(&stats, bar);
+    Ok(Loaded { env, build_seconds: Some(stats.blockers_seconds), load_seconds: None })
 }

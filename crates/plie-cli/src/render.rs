@@ -4,17 +4,14 @@
 use std::path::PathBuf;
 use std::time::Instant;
 
-use anyhow::{Context, Result};
-use plie::octree::Octree;
-
-use plie::render::render;
-use plie::visibility::bvh::Bvh;
-use plie::visibility::{self, Answer, Mode, QueryStats};
+use anyhow::{bail, Context, Result};
+use plie::visibility::{Answer, QueryStats};
+use plie::{Camera, Environment, Mode, Renderer, Shadows, Timing};
 use serde_json::json;
 
 use crate::image_args::ImageArgs;
 use crate::path_args::{Integrator, PathArgs};
-use crate::plie_args::{load_file, load_or_build, PlieArgs};
+use crate::plie_args::{build, load_file, PlieArgs};
 use crate::progress::Bar;
 use crate::render_path;
 use crate::scene_arg::{CameraArgs, SceneArgs};
@@ -107,9 +104,6 @@ pub fn run(a: &Args, matches: &clap::ArgMatches) -> Result<()> {
     let camera = a.camera.camera(&scene)?;
     a.image.size_for(&mut settings, &scene)?;
 
-    let t = Instant::now();
-    let bvh = Bvh::build(&scene);
-    let bvh_seconds = t.elapsed().as_secs_f64();
     let bar = Bar::new(a.quiet || a.json);
     let asked = a.visibility.unwrap_or(Mode::Bvh);
     let plie_file = if a.visibility.is_none_or(Mode::needs_plie) { a.plie.as_deref() } else { None };
@@ -121,54 +115,50 @@ pub fn run(a: &Args, matches: &clap::ArgMatches) -> Result<()> {
     // Face grids only serve mode `grid`: other modes skip building them.
     let params = a.params.params(asked == Mode::Grid)?;
     let t = Instant::now();
-    let (mode, octree, plie, plie_seconds, load_plie_seconds) = if asked.needs_plie() || plie_file.is_some() {
-        let got = match plie_file {
+    // The P-LIE modes answer from an environment (loaded or built), the others from `Shadows`.
+    let loaded = if asked.needs_plie() || plie_file.is_some() {
+        Some(match plie_file {
             Some(file) => load_file(&scene, file, &a.params, matches)?,
-            None => load_or_build(&scene, params, None, &bar)?,
-        };
-        let mode = a.visibility.unwrap_or_else(|| best_mode(&got.plie.params));
-        (mode, got.octree, Some(got.plie), got.build_seconds, got.load_seconds)
+            None => build(&scene, params, &bar)?,
+        })
     } else {
-        (asked, Octree::build(&scene, params.octree())?, None, None, None)
+        None
     };
+    let shadows = Shadows::with_octree_params(&scene, params.octree())?;
+    let env = loaded.as_ref().map(|l| &l.env);
+    let (plie_seconds, load_plie_seconds) = loaded.as_ref().map_or((None, None), |l| (l.build_seconds, l.load_seconds));
+    let octree = env.map_or_else(|| shadows.octree(), Environment::octree);
     let octree_seconds = t.elapsed().as_secs_f64() - plie_seconds.unwrap_or(0.0);
-    let vis = visibility::for_mode(mode, &scene, &bvh, &octree, plie.as_ref())?;
+    let t = Instant::now();
+    let bvh = env.map_or_else(|| shadows.bvh(), |e| e.bvh(&scene));
+    let bvh_seconds = t.elapsed().as_secs_f64();
+    let (mode, vis) = match env {
+        Some(env) => {
+            let mode = a.visibility.unwrap_or_else(|| env.best_mode());
+            (mode, env.visibility(mode, &scene)?)
+        }
+        None => (asked, shadows.visibility(asked)?),
+    };
+    // Only the P-LIE modes locate shaded points in the octree (the others do not use the leaf).
+    let leaves = mode.needs_plie().then_some(octree);
+    let integrator = match a.path.integrator {
+        Integrator::Path => plie::Integrator::Path(a.path.settings(settings.eye_rays)?),
+        Integrator::Direct => plie::Integrator::Direct,
+    };
+    let renderer = Renderer::new().settings(settings).integrator(integrator).progress(&bar);
+    let render = |camera: &Camera| renderer.camera(*camera).render_with(&scene, bvh, leaves, vis.as_ref());
     if let Some(walk) = walk {
-        let render_frame = |camera: &plie::Camera| -> Result<Vec<glam::Vec3>> {
-            if a.path.integrator == Integrator::Path {
-                let setup = render_path::Setup {
-                    scene: &scene,
-                    camera,
-                    settings,
-                    bvh: &bvh,
-                    octree: &octree,
-                    vis: vis.as_ref(),
-                    mode,
-                    bar: &bar,
-                };
-                return Ok(render_path::trace(&setup, &a.path)?.pixels);
-            }
-            Ok(render(&scene, camera, &settings, &bvh, Some(&octree), vis.as_ref(), &bar)?.pixels)
-        };
+        let render_frame = |camera: &Camera| -> Result<Vec<glam::Vec3>> { Ok(render(camera)?.pixels) };
         let save = |file: &std::path::Path, pixels| render_path::save(file, &settings, a.image.exposure, pixels);
         return walk.run(a.quiet, a.json, render_frame, save);
     }
+    let out = render(&camera)?;
     if a.path.integrator == Integrator::Path {
-        let setup = render_path::Setup {
-            scene: &scene,
-            camera: &camera,
-            settings,
-            bvh: &bvh,
-            octree: &octree,
-            vis: vis.as_ref(),
-            mode,
-            bar: &bar,
-        };
-        let out = render_path::trace(&setup, &a.path)?;
+        let traced = render_path::Traced::of(&out);
         let shadow_rays = out.stats.shadow_rays;
-        let seconds = out.seconds;
+        let seconds = traced.seconds;
         if a.json {
-            let mut v = render_path::json_fields(&out, &a.path, settings.eye_rays)?;
+            let mut v = render_path::json_fields(&traced, &a.path, settings.eye_rays)?;
             v["scene"] = json!(scene.name);
             v["visibility"] = json!(mode.name());
             v["width"] = json!(settings.width);
@@ -188,7 +178,7 @@ pub fn run(a: &Args, matches: &clap::ArgMatches) -> Result<()> {
                 scene.lights.len()
             );
             eprintln!("visibility       {}", mode);
-            render_path::print_stats(&out);
+            render_path::print_stats(&traced);
             print_answers(&out.stats);
         }
         render_path::save(&a.output, &settings, a.image.exposure, out.pixels)?;
@@ -197,7 +187,9 @@ pub fn run(a: &Args, matches: &clap::ArgMatches) -> Result<()> {
         }
         return Ok(());
     }
-    let out = render(&scene, &camera, &settings, &bvh, Some(&octree), vis.as_ref(), &bar)?;
+    let Timing::Direct { hit_buffer_seconds, shading_seconds, shading_cpu_seconds } = out.timing else {
+        bail!("direct light rendered without its timings");
+    };
     let pixels = match plie::io::ImageFormat::from_path(&a.output)? {
         plie::io::ImageFormat::Png if a.image.exposure != 0.0 => {
             let k = a.image.exposure.exp2();
@@ -210,7 +202,7 @@ pub fn run(a: &Args, matches: &clap::ArgMatches) -> Result<()> {
 
     let s = out.stats;
     let per_ray = if s.shadow_rays > 0 { s.triangle_tests as f64 / s.shadow_rays as f64 } else { 0.0 };
-    let rays_per_second = s.shadow_rays as f64 / out.shading_seconds.max(1e-9);
+    let rays_per_second = s.shadow_rays as f64 / shading_seconds.max(1e-9);
     if a.json {
         let v = json!({
             "scene": scene.name,
@@ -231,9 +223,9 @@ pub fn run(a: &Args, matches: &clap::ArgMatches) -> Result<()> {
             "octree_depth": octree.depth(),
             "build_seconds": plie_seconds,
             "plie_load_seconds": load_plie_seconds,
-            "hit_buffer_seconds": out.hit_buffer_seconds,
-            "shading_seconds": out.shading_seconds,
-            "shading_cpu_seconds": out.shading_cpu_seconds,
+            "hit_buffer_seconds": hit_buffer_seconds,
+            "shading_seconds": shading_seconds,
+            "shading_cpu_seconds": shading_cpu_seconds,
             "shadow_rays": s.shadow_rays,
             "occluded": s.occluded,
             "triangle_tests": s.triangle_tests,
@@ -274,8 +266,8 @@ pub fn run(a: &Args, matches: &clap::ArgMatches) -> Result<()> {
         if let Some(s) = load_plie_seconds {
             eprintln!("p-lie load       {s:.3} s");
         }
-        eprintln!("hit buffer       {:.3} s", out.hit_buffer_seconds);
-        eprintln!("shading          {:.3} s", out.shading_seconds);
+        eprintln!("hit buffer       {:.3} s", hit_buffer_seconds);
+        eprintln!("shading          {:.3} s", shading_seconds);
         eprintln!(
             "shadow rays      {} ({:.1}% occluded, {:.2} M/s)",
             s.shadow_rays,
@@ -290,7 +282,7 @@ pub fn run(a: &Args, matches: &clap::ArgMatches) -> Result<()> {
         print_answers(&s);
     }
     if !a.quiet && !a.json {
-        eprintln!("wrote {} ({:.2} s shading, {} shadow rays)", a.output.display(), out.shading_seconds, s.shadow_rays);
+        eprintln!("wrote {} ({:.2} s shading, {} shadow rays)", a.output.display(), shading_seconds, s.shadow_rays);
     }
     Ok(())
 }
@@ -319,17 +311,6 @@ fn print_answers(s: &QueryStats) {
         for (name, n) in [("whole umbra", l.whole_umbra), ("whole lit", l.whole_lit), ("per sample", l.per_sample)] {
             eprintln!("  {name:<14} {n:>12} {:>6.1}%", share(n));
         }
-    }
-}
-
-/// The fastest mode a P-LIE supports: `grid` with face grids, else `penumbra` with regions, else `lie`.
-fn best_mode(params: &plie::lie::PlieParams) -> Mode {
-    if params.has_grids() {
-        Mode::Grid
-    } else if params.has_regions() {
-        Mode::Penumbra
-    } else {
-        Mode::Lie
     }
 }
 

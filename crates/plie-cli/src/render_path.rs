@@ -3,42 +3,37 @@
 //! (rays by kind, time in shadow tests, shadow rays per second, the cost of locating path vertices).
 
 use anyhow::{Context, Result};
-use plie::octree::Octree;
-use plie::render::path::{render_path, PathRendered};
+use plie::render::path::PathStats;
 use plie::render::RenderSettings;
-use plie::visibility::bvh::Bvh;
-use plie::visibility::{Mode, Visibility};
-use plie::{Camera, Scene};
+use plie::visibility::QueryStats;
+use plie::{Image, Timing};
 use serde_json::json;
 
 use crate::path_args::PathArgs;
-use crate::progress::Bar;
 
-/// What `plie render` has set up before the estimator runs.
-pub struct Setup<'a> {
-    pub scene: &'a Scene,
-    pub camera: &'a Camera,
-    pub settings: RenderSettings,
-    pub bvh: &'a Bvh,
-    pub octree: &'a Octree,
-    pub vis: &'a dyn Visibility,
-    pub mode: Mode,
-    pub bar: &'a Bar,
+/// The figures of a path-traced image: wall-clock seconds, rays by kind, shadow-ray counters.
+pub struct Traced<'a> {
+    pub seconds: f64,
+    pub path: PathStats,
+    pub stats: &'a QueryStats,
 }
 
-/// Path-traces and returns the image and its figures. Only the P-LIE modes locate path vertices in
-/// the octree (the others do not use the leaf).
-pub fn trace(s: &Setup, args: &PathArgs) -> Result<PathRendered> {
-    let path = args.settings(s.settings.eye_rays)?;
-    let octree = s.mode.needs_plie().then_some(s.octree);
-    Ok(render_path(s.scene, s.camera, &s.settings, &path, s.bvh, octree, s.vis, s.bar)?)
+impl<'a> Traced<'a> {
+    /// The figures of `image`, rendered with the path tracer (zero timings for a direct-light image).
+    pub fn of(image: &'a Image) -> Traced<'a> {
+        let (seconds, path) = match image.timing {
+            Timing::Path { seconds, path } => (seconds, path),
+            Timing::Direct { .. } => (0.0, PathStats::default()),
+        };
+        Traced { seconds, path, stats: &image.stats }
+    }
 }
 
 /// The figures of a path-traced image as JSON fields.
-pub fn json_fields(out: &PathRendered, args: &PathArgs, k: u32) -> Result<serde_json::Value> {
+pub fn json_fields(out: &Traced, args: &PathArgs, k: u32) -> Result<serde_json::Value> {
     let path = args.settings(k)?;
     let p = &out.path;
-    let s = &out.stats;
+    let s = out.stats;
     Ok(json!({
         "integrator": "path",
         "spp": path.spp,
@@ -61,9 +56,9 @@ pub fn json_fields(out: &PathRendered, args: &PathArgs, k: u32) -> Result<serde_
 }
 
 /// Prints the figures of a path-traced image on stderr.
-pub fn print_stats(out: &PathRendered) {
+pub fn print_stats(out: &Traced) {
     let p = &out.path;
-    let s = &out.stats;
+    let s = out.stats;
     eprintln!("render           {:.3} s ({:.3} s summed over threads)", out.seconds, p.thread_seconds);
     eprintln!(
         "rays             {} camera, {} bounce, {} shadow ({:.1}% occluded)",

@@ -37,12 +37,13 @@ pub fn run(a: &Args) -> Result<()> {
     crate::scenes::set_threads(a.threads)?;
     let t = Instant::now();
     let scene = a.scene.load()?;
-    let (octree, plie) = plie::io::plie_file::load_plie(&a.file, &scene, None)
+    let env = plie::Environment::load(&a.file, &scene, None)
         .with_context(|| format!("cannot use P-LIE file {}", a.file.display()))?;
+    let (octree, plie) = (env.octree(), env.plie());
     let report = if a.full {
-        plie::verify::verify_full(&scene, &plie)
+        plie::verify::verify_full(&scene, plie)
     } else {
-        plie::verify::verify_sample(&scene, &octree, &plie, a.records as usize, a.rays as usize, a.seed)
+        plie::verify::verify_sample(&scene, octree, plie, a.records as usize, a.rays as usize, a.seed)
     };
     match report {
         Ok(r) if a.full => {

@@ -12,7 +12,8 @@ use plie::construct::refine::{MaxBlockers, RefineParams};
 pub use plie::io::camera_path::CameraPath;
 use plie::octree::{Octree, OctreeParams};
 use plie::visibility::bvh::Bvh;
-use plie::visibility::{self, QueryCtx, QueryStats, ShadowRay};
+use plie::visibility::{Brute, BvhVisibility, NoVisibility, OctreeVisibility, QueryCtx, QueryStats, ShadowRay};
+use plie::Visibility;
 pub use plie::Camera;
 use plie::{Environment, Grids, Integrator, Mode, Nee, PathSettings, PlieParams, Propagation, Regions};
 use plie::{LightId, Scene, TriId};
@@ -63,6 +64,19 @@ impl LoadedScene {
         }
         let o = Octree::build(&self.scene, BuildOptions::default().params(false)?.octree())?;
         Ok(self.octree.get_or_init(|| o))
+    }
+
+    /// The visibility `mode` without an environment, over the structures kept here (as
+    /// [`plie::Shadows::visibility`], which borrows the scene and so cannot live beside it).
+    fn visibility(&self, mode: Mode) -> Result<Box<dyn Visibility + '_>> {
+        let s = &self.scene;
+        Ok(match mode {
+            Mode::Brute => Box::new(Brute::new(s)),
+            Mode::Octree => Box::new(OctreeVisibility::new(s, self.octree()?)),
+            Mode::Bvh => Box::new(BvhVisibility::new(s, self.bvh())),
+            Mode::None => Box::new(NoVisibility),
+            m => return Err(invalid(format!("mode {m} answers from a P-LIE: build or load an Environment and pass it"))),
+        })
     }
 }
 
@@ -299,9 +313,8 @@ pub fn render(
             renderer.render(&scene.scene, m, Some(&built.env))
         }
         None => {
-            let bvh = scene.bvh();
-            let vis = visibility::for_mode(m, &scene.scene, bvh, scene.octree()?, None)?;
-            renderer.render_with(&scene.scene, bvh, None, vis.as_ref())
+            let vis = scene.visibility(m)?;
+            renderer.render_with(&scene.scene, scene.bvh(), None, vis.as_ref())
         }
     })?;
     Ok(Image {
@@ -370,10 +383,7 @@ pub fn occluded(
     };
     let vis = match env {
         Some(e) => e.env.visibility(m, s)?,
-        None if m.needs_plie() => {
-            return Err(invalid(format!("mode {m} answers from a P-LIE: build or load an Environment and pass it")))
-        }
-        None => visibility::for_mode(m, s, scene.bvh(), scene.octree()?, None)?,
+        None => scene.visibility(m)?,
     };
     let n = s.triangles.len();
     Ok(rays.par_iter().map_init(|| QueryCtx::new(n), |ctx, r| vis.occluded(r, ctx)).collect())

@@ -10,10 +10,8 @@ use std::time::Instant;
 use glam::Vec2;
 use plie::lie::PlieParams;
 use plie::octree::Octree;
-use plie::render::NoProgress;
-use plie::visibility::bvh::Bvh;
-use plie::visibility::{for_mode, Mode, QueryCtx, ShadowRay};
-use plie::{LightId, Scene, TriId};
+use plie::visibility::{Mode, QueryCtx, ShadowRay};
+use plie::{Environment, LightId, Scene, TriId};
 
 /// 4096 shadow rays from points on random triangles to light samples, `x` in front of the light.
 fn rays(scene: &Scene, octree: &Octree) -> Vec<ShadowRay> {
@@ -46,12 +44,10 @@ fn main() {
     for name in ["cornell-cube-3", "huis-a", "dragon", "boot"] {
         let scene = plie::scene::builtin::load(name).expect("built-in scene");
         let params = PlieParams::thesis();
-        let octree = Octree::build(&scene, params.octree()).expect("valid octree parameters");
-        let (plie, _) = plie::construct::build(&scene, &octree, params, &NoProgress);
-        let bvh = Bvh::build(&scene);
-        let rays = rays(&scene, &octree);
+        let (env, _) = Environment::build(&scene, &params).expect("valid parameters");
+        let rays = rays(&scene, env.octree());
         for mode in Mode::EXACT.into_iter().filter(|m| *m != Mode::Brute) {
-            let vis = for_mode(mode, &scene, &bvh, &octree, Some(&plie)).expect("mode");
+            let vis = env.visibility(mode, &scene).expect("mode");
             let mut ctx = QueryCtx::new(scene.triangle_count());
             let mut pass = || {
                 let t = Instant::now();

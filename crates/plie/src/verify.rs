@@ -31,7 +31,9 @@ pub struct Report {
 /// the first difference as an error message.
 pub fn verify_full(scene: &Scene, plie: &Plie) -> Result<Report, String> {
     let octree = Octree::build(scene, plie.params.octree()).map_err(|e| e.to_string())?;
-    let built = crate::construct::build_refined(scene, octree, plie.params, &NoProgress).plie;
+    let built = crate::construct::build_bounded(scene, octree, plie.params, Default::default(), &NoProgress)
+        .map_err(|e| e.to_string())?
+        .plie;
     first_difference(&built, plie)?;
     Ok(Report { records: plie.records.len(), rays: 0 })
 }

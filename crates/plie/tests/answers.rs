@@ -29,7 +29,7 @@ fn scenes() -> Vec<(Scene, Built)> {
 /// The shading pass at 40x40, one eye ray per pixel, 4 shadow rays per light.
 fn render_stats(scene: &Scene, built: &Built, mode: Mode) -> QueryStats {
     let camera = scene.camera_or_default();
-    let hits = HitBuffer::build(scene, &camera, (40, 40, 1), &built.bvh, Some(&built.octree));
+    let hits = HitBuffer::build(scene, &camera, (40, 40, 1), &built.bvh, Some(built.octree()));
     shade(scene, &hits, built.vis(scene, mode).as_ref(), 4, 7, &NoProgress).1
 }
 
@@ -103,7 +103,7 @@ fn shadow_rays(scene: &Scene, built: &Built, n: usize, seed: u64) -> Vec<ShadowR
             (rng.point_in(scene.bounds.min, scene.bounds.max), TriId(u32::MAX))
         };
         if (x - y).dot(light.normal) > 0.0 {
-            out.push(ShadowRay::new(x, y, LightId(li as u32), tri, built.octree.locate(x)));
+            out.push(ShadowRay::new(x, y, LightId(li as u32), tri, built.octree().locate(x)));
         }
     }
     out

@@ -9,8 +9,8 @@ use plie::construct::{build_bounded, Interrupted, Limits};
 use plie::lie::{Cell, PlieParams, RecordKind};
 use plie::octree::Octree;
 use plie::render::{NoProgress, Progress};
-use plie::visibility::{bvh::Bvh, for_mode, Brute, Mode, QueryCtx, Visibility};
-use plie::Scene;
+use plie::visibility::{Brute, Mode, QueryCtx, Visibility};
+use plie::{Environment, Scene};
 
 /// The stress scene at test size: 12 x 12 rods (1,452 triangles).
 fn balusters() -> Scene {
@@ -31,7 +31,7 @@ fn build(scene: &Scene, params: PlieParams, limits: Limits) -> plie::construct::
 /// Every exact P-LIE mode against brute force on `n` shadow rays; returns the rays answered by the
 /// scene BVH (summed over the modes).
 fn check_exact(scene: &Scene, built: &plie::construct::Built, n: usize) -> u64 {
-    let bvh = Bvh::build(scene);
+    let env = Environment::from_parts(scene, built.octree.clone(), built.plie.clone());
     let brute = Brute::new(scene);
     let rays = support::shadow_rays(scene, &built.octree, n, 15);
     let mut ctx = QueryCtx::new(scene.triangles.len());
@@ -40,7 +40,7 @@ fn check_exact(scene: &Scene, built: &plie::construct::Built, n: usize) -> u64 {
     assert!(blocked > n / 20 && blocked < n - n / 20, "{blocked} of {n} blocked: a weak test");
     let mut scene_answers = 0;
     for mode in [Mode::Lie, Mode::Umbra, Mode::Penumbra, Mode::Grid] {
-        let vis = for_mode(mode, scene, &bvh, &built.octree, Some(&built.plie)).unwrap();
+        let vis = env.visibility(mode, scene).unwrap();
         let mut ctx = QueryCtx::new(scene.triangles.len());
         for (k, (r, &e)) in rays.iter().zip(&expect).enumerate() {
             assert_eq!(vis.occluded(r, &mut ctx), e, "{mode}, ray {k}: {r:?}");
@@ -140,14 +140,14 @@ fn capped_p_lies_round_trip_through_files() {
     let built = build(&scene, params, Limits::default());
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("b.plie");
-    plie::io::plie_file::save_plie(&path, &scene, &built.octree, &built.plie).unwrap();
-    let (_, loaded) = plie::io::plie_file::load_plie(&path, &scene, Some(params)).unwrap();
-    assert!(loaded == built.plie);
+    Environment::from_parts(&scene, built.octree.clone(), built.plie.clone()).save(&path, &scene).unwrap();
+    let loaded = Environment::load(&path, &scene, Some(&params)).unwrap();
+    assert!(loaded.plie() == &built.plie);
     // Any cap answers exactly, so a file built with another cap is usable (like one with grids),
     // and keeps its own.
     let other = PlieParams { blocker_cap: None, ..params };
-    let (_, loaded) = plie::io::plie_file::load_plie(&path, &scene, Some(other)).unwrap();
-    assert_eq!(loaded.params.blocker_cap, Some(24));
+    let loaded = Environment::load(&path, &scene, Some(&other)).unwrap();
+    assert_eq!(loaded.params().blocker_cap, Some(24));
 }
 
 /// A progress that asks to stop after `after` steps.

@@ -10,7 +10,6 @@ use plie::construct::data_objects::{face_sees_light, thesis_face_sees_light};
 use plie::geometry::RayTest;
 use plie::lie::{PlieParams, Regions};
 use plie::octree::{Dir, LeafId, Octree};
-use plie::render::NoProgress;
 use plie::visibility::Mode;
 use plie::{LightId, Scene, SceneBuilder};
 
@@ -66,12 +65,20 @@ fn hits_any_t(scene: &Scene, a: Vec3, b: Vec3, t: usize) -> bool {
     RayTest::new(a, b - a, 0.0, 1.0).hit(&scene.triangles[t]).is_some()
 }
 
+/// The P-LIE of `scene` built with `params` by [`plie::Environment::build`], which builds the same
+/// `octree` (checked).
+fn build_on(scene: &Scene, octree: &Octree, params: PlieParams) -> (plie::lie::Plie, plie::BuildStats) {
+    let (env, stats) = plie::Environment::build(scene, &params).unwrap();
+    assert!(env.octree() == octree, "the environment's octree is the one of its parameters");
+    (env.into_parts().1, stats)
+}
+
 #[test]
 fn blockers_contain_every_triangle_between_face_and_light() {
     let scene = room();
     let params = PlieParams { max_triangles: 8, ..PlieParams::thesis() };
     let octree = Octree::build(&scene, params.octree()).expect("valid octree parameters");
-    let (plie, stats) = plie::construct::build(&scene, &octree, params, &NoProgress);
+    let (plie, stats) = build_on(&scene, &octree, params);
     assert!(stats.records > 0 && stats.blockers_total > 0);
     let mut rng = Rng(3);
     let mut checked = 0;
@@ -106,7 +113,7 @@ fn faces_without_a_record_receive_no_light() {
     let scene = room();
     let params = PlieParams { max_triangles: 8, regions: Regions::Skip, ..PlieParams::thesis() };
     let octree = Octree::build(&scene, params.octree()).expect("valid octree parameters");
-    let (plie, _) = plie::construct::build(&scene, &octree, params, &NoProgress);
+    let (plie, _) = build_on(&scene, &octree, params);
     let light = &scene.lights[0];
     let mut rng = Rng(11);
     let mut missing = 0;
@@ -164,7 +171,7 @@ fn lie_mode_matches_brute_force_in_the_room() {
     for max_triangles in [8, 200] {
         let params = PlieParams { max_triangles, ..PlieParams::default() };
         let octree = Octree::build(&scene, params.octree()).expect("valid octree parameters");
-        let (plie, stats) = plie::construct::build(&scene, &octree, params, &NoProgress);
+        let (plie, stats) = build_on(&scene, &octree, params);
         assert!(stats.grids > 0);
         let brute = Brute::new(&scene);
         let bvh = plie::visibility::bvh::Bvh::build(&scene);
@@ -226,7 +233,7 @@ fn lie_mode_matches_brute_force_with_lights_tilted_to_grazing() {
     }
     let params = PlieParams { max_triangles: 8, ..PlieParams::default() };
     let octree = Octree::build(&scene, params.octree()).expect("valid octree parameters");
-    let (plie, _) = plie::construct::build(&scene, &octree, params, &NoProgress);
+    let (plie, _) = build_on(&scene, &octree, params);
     let brute = Brute::new(&scene);
     let bvh = plie::visibility::bvh::Bvh::build(&scene);
     let modes = PLIE_MODES.map(|m| (m, LieVisibility::new(&scene, &bvh, &octree, &plie, m)));
@@ -268,7 +275,7 @@ fn construction_does_not_depend_on_the_thread_count() {
             let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
             pool.install(|| {
                 let octree = Octree::build(&scene, params.octree()).expect("valid octree parameters");
-                plie::construct::build(&scene, &octree, params, &NoProgress)
+                build_on(&scene, &octree, params)
             })
         };
         let (one, s1) = build(1);
@@ -285,7 +292,7 @@ fn grid_cells_contain_every_triangle_between_cell_and_light() {
     let scene = room();
     let params = PlieParams { max_triangles: 64, ..PlieParams::default() };
     let octree = Octree::build(&scene, params.octree()).expect("valid octree parameters");
-    let (plie, stats) = plie::construct::build(&scene, &octree, params, &NoProgress);
+    let (plie, stats) = build_on(&scene, &octree, params);
     assert!(stats.grids > 0, "{stats:?}");
     let mut rng = Rng(23);
     let mut checked = 0;

@@ -8,11 +8,10 @@ mod support;
 
 use glam::Vec3;
 use plie::compare::answer_diff;
-use plie::octree::Octree;
-use plie::render::{render, HitBuffer, NoProgress, RenderSettings};
+use plie::render::{HitBuffer, RenderSettings};
 use plie::visibility::bvh::Bvh;
 use plie::visibility::embree::native::{Exclusion, Packet};
-use plie::visibility::{for_mode, Brute, Mode, NativeEmbree, Visibility};
+use plie::visibility::{Brute, BvhVisibility, NativeEmbree, Visibility};
 use plie::Scene;
 
 /// At most this fraction of shadow-ray answers may differ from brute force, and the image's relative
@@ -28,18 +27,18 @@ const SETTINGS: RenderSettings = RenderSettings { width: 64, height: 64, eye_ray
 
 fn check(scene: &Scene) {
     let bvh = Bvh::build(scene);
-    let octree = Octree::build(scene, plie::lie::PlieParams::default().octree()).expect("valid octree parameters");
     let camera = scene.camera_or_default();
     let hits = HitBuffer::build(scene, &camera, (SETTINGS.width, SETTINGS.height, SETTINGS.eye_rays), &bvh, None);
     let native = NativeEmbree::new(scene).expect("Embree device");
     let exact: Box<dyn Visibility> = if scene.triangle_count() <= BRUTE_LIMIT {
         Box::new(Brute::new(scene))
     } else {
-        for_mode(Mode::Bvh, scene, &bvh, &octree, None).unwrap()
+        Box::new(BvhVisibility::new(scene, &bvh))
     };
     let diff = answer_diff(scene, &hits, &native, exact.as_ref(), SETTINGS.shadow_rays, SETTINGS.seed);
     // Images: native Embree against the exact image.
-    let image = |vis: &dyn Visibility| render(scene, &camera, &SETTINGS, &bvh, None, vis, &NoProgress).unwrap().pixels;
+    let renderer = plie::Renderer::new().settings(SETTINGS).camera(camera);
+    let image = |vis: &dyn Visibility| renderer.render_with(scene, &bvh, None, vis).unwrap().pixels;
     let (got, want) = (image(&native), image(exact.as_ref()));
     let differing_pixels = got.iter().zip(&want).filter(|(a, b)| a != b).count();
     let abs: f32 = got.iter().zip(&want).map(|(a, b)| (*a - *b).abs().element_sum()).sum();

@@ -87,10 +87,10 @@ fn compare(scene: &Scene, built: &Built, what: &str, modes: &[Mode], rays: &[Sha
 
 fn check_scene(scene: &Scene, segments: usize, seed: u64) {
     let built = Built::new(scene, PlieParams::thesis());
-    let rays = shadow_rays(scene, &built.octree, segments, seed);
+    let rays = shadow_rays(scene, built.octree(), segments, seed);
     compare(scene, &built, "shadow ray", &Mode::EXACT, &rays);
     let free: Vec<Mode> = Mode::EXACT.into_iter().filter(|m| !m.needs_plie()).collect();
-    let segs = free_segments(scene, &built.octree, segments / 4, seed + 1);
+    let segs = free_segments(scene, built.octree(), segments / 4, seed + 1);
     compare(scene, &built, "free segment", &free, &segs);
 }
 

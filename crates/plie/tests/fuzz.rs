@@ -260,7 +260,7 @@ fn the_plie_seed_loads() {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("seed.plie");
     std::fs::write(&path, bytes).unwrap();
-    plie::io::plie_file::load_plie(&path, scene, None).unwrap();
+    plie::Environment::load(&path, scene, None).unwrap();
     // The edits keep an empty program's input as it is and change it otherwise.
     assert_eq!(&targets::apply_edits(bytes, &[]), bytes);
     assert_ne!(&targets::apply_edits(bytes, &[1, 91, 1, 0, 0, 51, 0]), bytes);

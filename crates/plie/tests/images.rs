@@ -5,7 +5,7 @@ mod support;
 
 use glam::Vec3;
 use plie::lie::PlieParams;
-use plie::render::{render, NoProgress, RenderSettings};
+use plie::render::RenderSettings;
 use plie::visibility::Mode;
 use plie::Scene;
 use support::Built;
@@ -20,8 +20,7 @@ fn images(scene: &Scene, threads: usize, settings: &RenderSettings) -> Vec<(Mode
             .into_iter()
             .map(|mode| {
                 let vis = built.vis(scene, mode);
-                let px = render(scene, &camera, settings, &built.bvh, Some(&built.octree), vis.as_ref(), &NoProgress);
-                (mode, px.unwrap().pixels)
+                (mode, support::render(scene, &camera, settings, &built.bvh, Some(built.octree()), vis.as_ref()))
             })
             .collect()
     })

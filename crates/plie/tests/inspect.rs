@@ -8,14 +8,14 @@ use plie::inspect::summary::Filter;
 use plie::inspect::{FaceStatus, Inspector};
 use plie::lie::{Plie, PlieParams, Regions};
 use plie::octree::{Dir, Octree};
-use plie::render::{render, HitBuffer, NoProgress, RenderSettings};
+use plie::render::{HitBuffer, NoProgress, RenderSettings};
 use plie::visibility::bvh::Bvh;
 use plie::visibility::BvhVisibility;
 use plie::{LightId, Scene};
 
 fn build(scene: &Scene, params: PlieParams) -> (Octree, Plie, plie::construct::BuildStats) {
-    let octree = Octree::build(scene, params.octree()).expect("valid octree parameters");
-    let (plie, stats) = plie::construct::build(scene, &octree, params, &NoProgress);
+    let (env, stats) = plie::Environment::build(scene, &params).unwrap();
+    let (octree, plie) = env.into_parts();
     (octree, plie, stats)
 }
 
@@ -148,7 +148,8 @@ fn overlay_shades_the_scene_exactly_as_render_and_markers_cast_no_shadows() {
     let style = OverlayStyle::default();
     let picture = render_inspection(&scene, &octree, &view, &camera, &settings, &style, &NoProgress).unwrap();
     let bvh = Bvh::build(&scene);
-    let plain = render(&scene, &camera, &settings, &bvh, None, &BvhVisibility::new(&scene, &bvh), &NoProgress).unwrap();
+    let plain = plie::Renderer::new().settings(settings).camera(camera);
+    let plain = plain.render_with(&scene, &bvh, None, &BvhVisibility::new(&scene, &bvh)).unwrap();
 
     let overlay = overlay_scene(&scene, &octree, &view, &camera, settings.height, &style);
     assert_eq!(&overlay.triangles[..scene.triangles.len()].len(), &scene.triangles.len());

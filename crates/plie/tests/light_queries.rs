@@ -35,13 +35,13 @@ fn queries(scene: &Scene, built: &Built, n: usize, seed: u64) -> Vec<Query> {
     while out.len() < n {
         let li = rng.below(scene.lights.len());
         let light = &scene.lights[li];
-        let (x, tri) = start_point(scene, &built.octree, &mut rng);
+        let (x, tri) = start_point(scene, built.octree(), &mut rng);
         if (x - light.vertices[0]).dot(light.normal) <= 0.0 {
             continue;
         }
         let count = if rng.below(3) == 0 { 64 } else { 1 + rng.below(80) };
         let targets = (0..count).map(|_| light.sample(Vec2::new(rng.f32(), rng.f32()))).collect();
-        let leaf = if rng.below(4) == 0 { None } else { built.octree.locate(x) };
+        let leaf = if rng.below(4) == 0 { None } else { built.octree().locate(x) };
         out.push(Query { x, tri, leaf, light: LightId(li as u32), targets });
     }
     out
@@ -144,7 +144,7 @@ proptest! {
         let light = &scene.lights[0];
         prop_assume!((x - light.vertices[0]).dot(light.normal) > 0.0);
         let targets: Vec<Vec3> = us.iter().map(|&(u, v)| light.sample(Vec2::new(u, v))).collect();
-        let q = Query { x, tri: TriId(u32::MAX), leaf: if give_leaf { built.octree.locate(x) } else { None }, light: LightId(0), targets };
+        let q = Query { x, tri: TriId(u32::MAX), leaf: if give_leaf { built.octree().locate(x) } else { None }, light: LightId(0), targets };
         let rays = q.rays();
         let mut ctx = QueryCtx::new(scene.triangles.len());
         let brute = built.vis(scene, Mode::Brute);

@@ -12,7 +12,7 @@ use std::path::{Path, PathBuf};
 use glam::{Vec2, Vec3};
 use plie::io::{load_scene, load_scene_with, LoadOptions};
 use plie::lie::PlieParams;
-use plie::render::{render, NoProgress, RenderSettings};
+use plie::render::RenderSettings;
 use plie::scene::texture::srgb_to_linear;
 use plie::visibility::Mode;
 use plie::{Scene, TriId};
@@ -31,7 +31,7 @@ fn image(scene: &Scene, mode: Mode, settings: &RenderSettings) -> Vec<Vec3> {
     let built = Built::new(scene, PlieParams::default());
     let vis = built.vis(scene, mode);
     let camera = scene.camera.expect("the scene has a camera");
-    render(scene, &camera, settings, &built.bvh, Some(&built.octree), vis.as_ref(), &NoProgress).unwrap().pixels
+    support::render(scene, &camera, settings, &built.bvh, Some(built.octree()), vis.as_ref())
 }
 
 fn small() -> RenderSettings {

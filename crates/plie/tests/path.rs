@@ -6,12 +6,17 @@
 
 use glam::Vec3;
 use plie::lie::PlieParams;
-use plie::octree::Octree;
-use plie::render::path::{render_path, Nee, PathRendered, PathSettings};
-use plie::render::{render, NoProgress, RenderSettings};
-use plie::visibility::bvh::Bvh;
-use plie::visibility::{for_mode, Mode};
-use plie::{Camera, Material, Scene, SceneBuilder, TriId};
+use plie::render::path::{Nee, PathSettings, PathStats};
+use plie::render::RenderSettings;
+use plie::visibility::{Mode, QueryStats};
+use plie::{Camera, Environment, Integrator, Material, Renderer, Scene, SceneBuilder, Timing, TriId};
+
+/// A path-traced image and its figures.
+struct PathRendered {
+    pixels: Vec<Vec3>,
+    stats: QueryStats,
+    path: PathStats,
+}
 
 /// A closed unit cube, every face an inward-facing light of radiance `le` and albedo `rho`.
 fn furnace(rho: f32, le: f32) -> Scene {
@@ -46,13 +51,12 @@ fn inside_camera() -> Camera {
 
 fn trace(scene: &Scene, camera: &Camera, size: u32, n: u32, path: PathSettings, mode: Mode) -> PathRendered {
     let settings = RenderSettings { width: size, height: size, eye_rays: 1, shadow_rays: n, seed: 7 };
-    let bvh = Bvh::build(scene);
     let params = PlieParams { max_triangles: 4, ..PlieParams::default() };
-    let octree = Octree::build(scene, params.octree()).expect("valid octree parameters");
-    let plie = mode.needs_plie().then(|| plie::construct::build(scene, &octree, params, &NoProgress).0);
-    let vis = for_mode(mode, scene, &bvh, &octree, plie.as_ref()).unwrap();
-    let oc = mode.needs_plie().then_some(&octree);
-    render_path(scene, camera, &settings, &path, &bvh, oc, vis.as_ref(), &NoProgress).unwrap()
+    let env = mode.needs_plie().then(|| Environment::build(scene, &params).unwrap().0);
+    let renderer = Renderer::new().settings(settings).camera(*camera).integrator(Integrator::Path(path));
+    let image = renderer.render(scene, mode, env.as_ref()).unwrap();
+    let Timing::Path { path, .. } = image.timing else { panic!("not path-traced") };
+    PathRendered { pixels: image.pixels, stats: image.stats, path }
 }
 
 /// Mean of the first channel over pixels, and its standard error (pixels are independent).
@@ -105,10 +109,7 @@ fn depth_two_equals_direct_light_in_expectation() {
     let path = PathSettings { spp: 64, max_depth: 2, rr_depth: None, nee: Nee::All };
     let traced = trace(&scene, &camera, size, 4, path, Mode::Bvh);
     let settings = RenderSettings { width: size, height: size, eye_rays: 8, shadow_rays: 16, seed: 3 };
-    let bvh = Bvh::build(&scene);
-    let octree = Octree::build(&scene, Default::default()).expect("valid octree parameters");
-    let vis = for_mode(Mode::Bvh, &scene, &bvh, &octree, None).unwrap();
-    let direct = render(&scene, &camera, &settings, &bvh, None, vis.as_ref(), &NoProgress).unwrap();
+    let direct = Renderer::new().settings(settings).camera(camera).render(&scene, Mode::Bvh, None).unwrap();
     // Per-pixel differences: their mean is zero in expectation; compare it with its standard error.
     let diff: Vec<Vec3> = traced.pixels.iter().zip(&direct.pixels).map(|(a, b)| *a - *b).collect();
     let (d, se) = mean_and_error(&diff);

@@ -3,24 +3,33 @@
 
 mod support;
 
-use plie::io::plie_file::{load_plie, save_plie, FORMAT_VERSION, MAGIC};
-use plie::lie::PlieParams;
-use plie::octree::Octree;
-use plie::render::{render, NoProgress, RenderSettings};
-use plie::visibility::{bvh::Bvh, for_mode, Mode};
-use plie::Scene;
+use std::path::Path;
 
-fn built(scene: &Scene, params: PlieParams) -> (Octree, plie::lie::Plie) {
-    let octree = Octree::build(scene, params.octree()).expect("valid octree parameters");
-    let (p, _) = plie::construct::build(scene, &octree, params, &NoProgress);
-    (octree, p)
+use plie::io::plie_file::{FORMAT_VERSION, MAGIC};
+use plie::lie::{Plie, PlieParams};
+use plie::octree::Octree;
+use plie::render::RenderSettings;
+use plie::visibility::Mode;
+use plie::{Environment, Renderer, Scene};
+
+fn built(scene: &Scene, params: PlieParams) -> (Octree, Plie) {
+    Environment::build(scene, &params).unwrap().0.into_parts()
 }
 
-fn image(scene: &Scene, octree: &Octree, p: &plie::lie::Plie) -> Vec<[u32; 3]> {
-    let bvh = Bvh::build(scene);
-    let vis = for_mode(Mode::Lie, scene, &bvh, octree, Some(p)).unwrap();
+/// [`Environment::save`] of an octree and a P-LIE (possibly altered).
+fn save_plie(path: &Path, scene: &Scene, octree: &Octree, p: &Plie) -> plie::Result<u64> {
+    Environment::from_parts(scene, octree.clone(), p.clone()).save(path, scene)
+}
+
+/// [`Environment::load`], in parts.
+fn load_plie(path: &Path, scene: &Scene, expect: Option<PlieParams>) -> plie::Result<(Octree, Plie)> {
+    Environment::load(path, scene, expect.as_ref()).map(Environment::into_parts)
+}
+
+fn image(scene: &Scene, octree: &Octree, p: &Plie) -> Vec<[u32; 3]> {
+    let env = Environment::from_parts(scene, octree.clone(), p.clone());
     let s = RenderSettings { width: 48, height: 48, eye_rays: 1, shadow_rays: 4, seed: 11 };
-    let img = render(scene, &scene.camera_or_default(), &s, &bvh, Some(octree), vis.as_ref(), &NoProgress).unwrap();
+    let img = Renderer::new().settings(s).render(scene, Mode::Lie, Some(&env)).unwrap();
     img.pixels.iter().map(|v| v.to_array().map(f32::to_bits)).collect()
 }
 
@@ -122,26 +131,22 @@ fn refined_round_trip_and_refinement_mismatch() {
     let dir = tempfile::tempdir().unwrap();
     let scene = plie::scene::builtin::load("cornell-cube-5").unwrap();
     let params = PlieParams { refine: RefineParams::thesis_umbra(), ..PlieParams::thesis() };
-    let b = plie::construct::build_refined(
-        &scene,
-        Octree::build(&scene, params.octree()).expect("valid octree parameters"),
-        params,
-        &NoProgress,
-    );
-    assert!(!b.plie.splits.is_empty());
+    let (env, _) = Environment::build(&scene, &params).unwrap();
+    let (b_octree, b_plie) = env.into_parts();
+    assert!(!b_plie.splits.is_empty());
     let path = dir.path().join("refined.plie");
-    save_plie(&path, &scene, &b.octree, &b.plie).unwrap();
+    save_plie(&path, &scene, &b_octree, &b_plie).unwrap();
     let (octree2, p2) = load_plie(&path, &scene, Some(params)).unwrap();
-    assert!(octree2 == b.octree && p2 == b.plie);
-    assert_eq!(image(&scene, &b.octree, &b.plie), image(&scene, &octree2, &p2));
+    assert!(octree2 == b_octree && p2 == b_plie);
+    assert_eq!(image(&scene, &b_octree, &b_plie), image(&scene, &octree2, &p2));
     assert!(load_plie(&path, &scene, None).is_ok());
     let e = err_of(load_plie(&path, &scene, Some(PlieParams::thesis())));
     assert!(e.contains("other parameters"), "{e}");
     // A split list naming a node that is no leaf: the file is refused.
-    let mut bad = b.plie.clone();
+    let mut bad = b_plie.clone();
     bad.splits[0][0] = 0;
     let q = dir.path().join("bad-splits.plie");
-    save_plie(&q, &scene, &b.octree, &bad).unwrap();
+    save_plie(&q, &scene, &b_octree, &bad).unwrap();
     let e = err_of(load_plie(&q, &scene, None));
     assert!(e.contains("inconsistent") && e.contains("node 0"), "{e}");
 }

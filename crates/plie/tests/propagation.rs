@@ -13,10 +13,10 @@
 mod support;
 
 use glam::{Vec2, Vec3};
-use plie::construct::{build_traced, Built};
+use plie::construct::Built;
 use plie::lie::{Plie, PlieParams, Propagation};
 use plie::octree::{Dir, LeafId, Octree};
-use plie::render::{render, NoProgress, RenderSettings};
+use plie::render::RenderSettings;
 use plie::visibility::lie::exit_face;
 use plie::visibility::{Brute, Mode, QueryCtx, ShadowRay, Visibility};
 use plie::{LightId, Scene, TriId};
@@ -27,7 +27,7 @@ use support::TestRng;
 const MAX_TRIANGLES: usize = 50_000;
 
 fn build(scene: &Scene, octree: &Octree, params: PlieParams) -> Built {
-    build_traced(scene, octree, params, &NoProgress)
+    support::construct(scene, octree, params)
 }
 
 /// Every sampled segment from each propagated face (corners, edges and interior) to its light, and
@@ -166,11 +166,10 @@ fn propagated_records_of_refined_p_lies_are_dark() {
         let scene = plie::scene::builtin::load(name).unwrap();
         let params =
             PlieParams { refine: plie::construct::refine::RefineParams::thesis_umbra(), ..PlieParams::thesis() };
-        let b = plie::construct::build_refined(
+        let b = support::construct(
             &scene,
-            Octree::build(&scene, params.octree()).expect("valid octree parameters"),
+            &Octree::build(&scene, params.octree()).expect("valid octree parameters"),
             params,
-            &NoProgress,
         );
         assert!(b.stats.refine_rounds > 0);
         assert_eq!(b.stats.records_removed_propagation, b.propagated.len());
@@ -210,10 +209,11 @@ fn images_with_many_propagated_records_match_brute_force() {
         assert!(built.propagated.len() > 100, "{name}: {}", built.propagated.len());
         let bvh = plie::visibility::bvh::Bvh::build(&scene);
         let camera = scene.camera_or_default();
+        let env = plie::Environment::from_parts(&scene, octree.clone(), built.plie.clone());
         let image = |mode: Mode| {
-            let vis = plie::visibility::for_mode(mode, &scene, &bvh, &octree, Some(&built.plie)).unwrap();
-            let px = render(&scene, &camera, &settings, &bvh, Some(&octree), vis.as_ref(), &NoProgress).unwrap();
-            px.pixels.iter().map(|v| v.to_array().map(f32::to_bits)).collect::<Vec<_>>()
+            let vis = env.visibility(mode, &scene).unwrap();
+            let px = support::render(&scene, &camera, &settings, &bvh, Some(&octree), vis.as_ref());
+            px.iter().map(|v| v.to_array().map(f32::to_bits)).collect::<Vec<_>>()
         };
         let reference = image(Mode::Brute);
         for mode in [Mode::Lie, Mode::Umbra, Mode::Penumbra, Mode::Grid] {

@@ -10,10 +10,9 @@ mod support;
 
 use glam::Vec3;
 use plie::construct::refine::{MaxBlockers, RefineParams};
-use plie::construct::{build, build_refined};
 use plie::lie::{Grids, PlieParams, Propagation};
 use plie::octree::Octree;
-use plie::render::{render, NoProgress, RenderSettings};
+use plie::render::RenderSettings;
 use plie::visibility::{Mode, QueryCtx};
 use plie::Scene;
 use rayon::prelude::*;
@@ -32,16 +31,12 @@ fn check_exact(scene: &Scene, built: &Built, settings: &RenderSettings, rays: us
     let camera = scene.camera_or_default();
     let image = |mode: Mode| {
         let vis = built.vis(scene, mode);
-        bits(
-            &render(scene, &camera, settings, &built.bvh, Some(&built.octree), vis.as_ref(), &NoProgress)
-                .unwrap()
-                .pixels,
-        )
+        bits(&support::render(scene, &camera, settings, &built.bvh, Some(built.octree()), vis.as_ref()))
     };
     let reference = image(Mode::Brute);
     let lit = reference.iter().filter(|p| p.iter().any(|&c| f32::from_bits(c) > 0.0)).count();
     assert!(lit > reference.len() / 4, "{}: the image is mostly black", scene.name);
-    let rays = support::shadow_rays(scene, &built.octree, rays, 4321);
+    let rays = support::shadow_rays(scene, built.octree(), rays, 4321);
     let answers = |mode: Mode| -> Vec<bool> {
         let vis = built.vis(scene, mode);
         rays.par_chunks(256)
@@ -64,8 +59,8 @@ fn refined_p_lies_are_exact_on_builtin_scenes() {
     let settings = RenderSettings { width: 32, height: 32, eye_rays: 1, shadow_rays: 4, seed: 11 };
     for scene in support::builtins() {
         let built = Built::refined(&scene, refined_params());
-        assert_eq!(built.plie.params.refine, RefineParams::thesis_umbra());
-        assert!(!built.plie.splits.is_empty(), "{}: refinement by umbra split nothing", scene.name);
+        assert_eq!(built.plie().params.refine, RefineParams::thesis_umbra());
+        assert!(!built.plie().splits.is_empty(), "{}: refinement by umbra split nothing", scene.name);
         check_exact(&scene, &built, &settings, 20_000);
     }
 }
@@ -76,7 +71,7 @@ fn refined_p_lies_are_exact_on_shared_scenes() {
     let settings = RenderSettings { width: 24, height: 24, eye_rays: 1, shadow_rays: 4, seed: 13 };
     for scene in support::load_shared() {
         let built = Built::refined(&scene, refined_params());
-        eprintln!("{}: {} leaves after refinement", scene.name, built.octree.leaf_count());
+        eprintln!("{}: {} leaves after refinement", scene.name, built.octree().leaf_count());
         check_exact(&scene, &built, &settings, 5_000);
     }
 }
@@ -100,10 +95,10 @@ fn reused_records_equal_a_build_from_scratch() {
         let scene = plie::scene::builtin::load(name).unwrap();
         let params = PlieParams { propagation: Propagation::Off, grids: Grids::Build, ..refined_params() };
         let octree = Octree::build(&scene, params.octree()).expect("valid octree parameters");
-        let refined = build_refined(&scene, octree, params, &NoProgress);
+        let refined = support::construct(&scene, &octree, params);
         assert!(refined.stats.refine_rounds > 0, "{name}: nothing split");
-        let (fresh, stats) =
-            build(&scene, &refined.octree, PlieParams { refine: RefineParams::none(), ..params }, &NoProgress);
+        let fresh = support::construct(&scene, &refined.octree, PlieParams { refine: RefineParams::none(), ..params });
+        let (fresh, stats) = (fresh.plie, fresh.stats);
         let mut got = refined.plie.clone();
         got.splits.clear();
         got.params.refine = RefineParams::none();
@@ -122,8 +117,7 @@ fn refinement_does_not_depend_on_the_thread_count() {
             let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
             pool.install(|| {
                 let octree = Octree::build(&scene, PlieParams::thesis().octree()).expect("valid octree parameters");
-                let b =
-                    build_refined(&scene, octree, PlieParams { grids: Grids::Build, ..refined_params() }, &NoProgress);
+                let b = support::construct(&scene, &octree, PlieParams { grids: Grids::Build, ..refined_params() });
                 (b.octree, b.plie, b.propagated)
             })
         };
@@ -144,7 +138,7 @@ fn max_split_depth_bounds_a_chain_that_would_never_stop() {
     for k in 0..=3u32 {
         let refine = RefineParams { blockers: Some(MaxBlockers::Fixed(0)), max_split_depth: k, ..RefineParams::none() };
         let params = PlieParams { refine, ..PlieParams::thesis() };
-        let b = build_refined(&scene, base.clone(), params, &NoProgress);
+        let b = support::construct(&scene, &base, params);
         assert_eq!(b.stats.refine_rounds, k as usize, "k = {k}");
         assert_eq!(b.plie.splits.len(), k as usize);
         assert_eq!(b.octree.depth(), 1 + k, "k = {k}: some leaf splits exactly k times");
@@ -170,8 +164,8 @@ fn max_split_depth_bounds_a_chain_that_would_never_stop() {
 fn umbra_refinement_removes_more_dark_records() {
     let scene = plie::scene::builtin::load("cornell-cube-1").unwrap();
     let octree = Octree::build(&scene, PlieParams::thesis().octree()).expect("valid octree parameters");
-    let (_, plain) = build(&scene, &octree, PlieParams::thesis(), &NoProgress);
-    let b = build_refined(&scene, octree, refined_params(), &NoProgress);
+    let plain = support::construct(&scene, &octree, PlieParams::thesis()).stats;
+    let b = support::construct(&scene, &octree, refined_params());
     assert!(b.stats.refine_splits.get("umbra_full").copied().unwrap_or(0) > 0, "{:?}", b.stats.refine_splits);
     let dark = |s: &plie::construct::BuildStats| s.records_removed_umbra + s.records_removed_propagation;
     assert!(dark(&b.stats) > dark(&plain), "refined {} dark records, unrefined {}", dark(&b.stats), dark(&plain));

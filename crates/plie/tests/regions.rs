@@ -12,7 +12,6 @@ use plie::lie::frame::{face_axes, in_triangles, FaceFrame, Tri2, UNITS};
 use plie::lie::grid::cell_box;
 use plie::lie::{Cell, Plie, PlieParams, Propagation, Regions};
 use plie::octree::{Dir, LeafId, Octree};
-use plie::render::NoProgress;
 use plie::visibility::query::SEGMENT_EPS;
 use plie::{LightId, Scene, SceneBuilder, TriId};
 use support::TestRng;
@@ -38,9 +37,7 @@ fn point_in(t: &Tri2, rng: &mut TestRng) -> DVec2 {
 }
 
 fn build(scene: &Scene, params: PlieParams) -> (Octree, Plie) {
-    let octree = Octree::build(scene, params.octree()).expect("valid octree parameters");
-    let (plie, _) = plie::construct::build(scene, &octree, params, &NoProgress);
-    (octree, plie)
+    plie::Environment::build(scene, &params).unwrap().0.into_parts()
 }
 
 /// Checks every record's regions and grid cells, and every removed record, against sampled segments.

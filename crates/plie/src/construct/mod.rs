@@ -85,33 +85,18 @@ pub struct Built {
     pub propagated: Vec<Propagated>,
 }
 
-/// Builds the P-LIE of `scene` over `octree` (stages 1-6), without refinement.
-///
-/// # Panics
-/// If `params.refine` asks for refinement, which changes the octree: use [`build_refined`].
-pub fn build(scene: &Scene, octree: &Octree, params: PlieParams, progress: &dyn Progress) -> (Plie, BuildStats) {
-    let b = build_traced(scene, octree, params, progress);
+/// [`build_bounded`] without limits or refinement, for the crate's unit tests.
+#[cfg(test)]
+pub(crate) fn build(scene: &Scene, octree: &Octree, params: PlieParams, progress: &dyn Progress) -> (Plie, BuildStats) {
+    assert!(!params.refine.enabled(), "construct::build does not refine the octree");
+    let b = build_bounded(scene, octree.clone(), params, Limits::default(), progress).expect("not cancelled");
     (b.plie, b.stats)
 }
 
-/// [`build`], also returning which records propagation deleted (for tests and reports).
-///
-/// # Panics
-/// If `params.refine` asks for refinement: use [`build_refined`].
-pub fn build_traced(scene: &Scene, octree: &Octree, params: PlieParams, progress: &dyn Progress) -> Built {
-    assert!(!params.refine.enabled(), "construct::build does not refine the octree: use construct::build_refined");
-    build_refined(scene, octree.clone(), params, progress)
-}
-
 /// Builds the P-LIE of `scene` over `octree` (stages 1-6) and refines the octree as `params.refine`
-/// asks (stage 7), returning the refined octree with it.
-pub fn build_refined(scene: &Scene, octree: Octree, params: PlieParams, progress: &dyn Progress) -> Built {
-    build_bounded(scene, octree, params, Limits::default(), progress)
-        .expect("construction interrupted: use build_bounded with a progress that can cancel")
-}
-
-/// [`build_refined`] within `limits`; returns [`Interrupted`] as soon as `progress` says
-/// [`Progress::cancelled`].
+/// asks (stage 7), within `limits`, returning the refined octree with it; returns [`Interrupted`] as
+/// soon as `progress` says [`Progress::cancelled`]. ([`crate::Environment::build`] is the entry point
+/// for users: it builds the octree from the parameters and checks them first.)
 pub fn build_bounded(
     scene: &Scene,
     octree: Octree,

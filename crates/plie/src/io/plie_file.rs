@@ -97,7 +97,7 @@ pub fn octree_fingerprint(octree: &Octree) -> u64 {
 }
 
 /// Saves the P-LIE built for `scene` on `octree`, atomically. Returns the bytes written.
-pub fn save_plie(path: &Path, scene: &Scene, octree: &Octree, plie: &Plie) -> Result<u64> {
+pub(crate) fn save_plie(path: &Path, scene: &Scene, octree: &Octree, plie: &Plie) -> Result<u64> {
     let body = FileBody {
         params: plie.params,
         scene_fingerprint: scene_fingerprint(scene),
@@ -123,14 +123,14 @@ pub fn save_plie(path: &Path, scene: &Scene, octree: &Octree, plie: &Plie) -> Re
 /// not matter, modes use them when present), rebuilds the octree and checks that it is the one the
 /// P-LIE was built on. Returns the octree and the P-LIE. Every problem with the file is an
 /// [`Error::PlieFile`].
-pub fn load_plie(path: &Path, scene: &Scene, expect: Option<PlieParams>) -> Result<(Octree, Plie)> {
+pub(crate) fn load_plie(path: &Path, scene: &Scene, expect: Option<PlieParams>) -> Result<(Octree, Plie)> {
     let bytes = super::input::read_bounded(path, super::input::MAX_INPUT_BYTES)?;
     read_plie(&bytes, scene, expect).map_err(|problem| Error::PlieFile { path: path.to_path_buf(), problem })
 }
 
 /// [`load_plie`] from the bytes of a `.plie` file already in memory (e.g. fetched from a distributed
 /// object store), with the same checks; `origin` names the bytes in errors.
-pub fn load_plie_bytes(
+pub(crate) fn load_plie_bytes(
     bytes: &[u8],
     origin: &str,
     scene: &Scene,

@@ -76,7 +76,7 @@ pub struct Rendered {
 
 /// Renders `scene` from `camera`: hit buffer with `bvh` (and leaves from `octree` if given), then shading
 /// with `vis`.
-pub fn render(
+pub(crate) fn render(
     scene: &Scene,
     camera: &Camera,
     settings: &RenderSettings,

@@ -81,19 +81,6 @@ impl Visibility for NoVisibility {
     }
 }
 
-/// The visibility method for `mode`, over the structures already built. Fails if `mode` needs a
-/// P-LIE and none is given. [`Mode::Embree`] and [`Mode::EmbreeExact`] (feature `embree`) build their own
-/// Embree scene here, owned by the returned box, and fail if Embree cannot be set up.
-pub fn for_mode<'a>(
-    mode: Mode,
-    scene: &'a crate::Scene,
-    bvh: &'a bvh::Bvh,
-    octree: &'a crate::octree::Octree,
-    plie: Option<&'a crate::lie::Plie>,
-) -> crate::Result<Box<dyn Visibility + 'a>> {
-    make(mode, scene, || bvh, || octree, plie)
-}
-
 /// The visibility method for `mode`; `bvh` and `octree` are asked for only by the modes that use
 /// them. Fails if `mode` needs a P-LIE and none is given, or needs regions the P-LIE lacks.
 pub(crate) fn make<'a>(

@@ -11,11 +11,11 @@
 use std::path::Path;
 use std::sync::OnceLock;
 
-use plie::io::plie_file::{checksum, load_plie, save_plie};
+use plie::io::plie_file::checksum;
 use plie::io::{load_scene_with, LoadOptions};
 use plie::octree::{Octree, OctreeParams};
 use plie::visibility::bvh::Bvh;
-use plie::Scene;
+use plie::{Environment, Scene};
 
 /// A target: what it does with one input.
 pub type Target = fn(&[u8]);
@@ -131,8 +131,8 @@ pub fn plie_file(bytes: &[u8], fix_checksum: bool) {
     }
     let (scene, _) = plie_seed();
     with_files("f.plie", &bytes, &[], |dir| {
-        if let Ok((octree, plie)) = load_plie(&dir.join("f.plie"), scene, None) {
-            let _ = plie::verify::verify_sample(scene, &octree, &plie, 8, 4, 1);
+        if let Ok(env) = Environment::load(&dir.join("f.plie"), scene, None) {
+            let _ = plie::verify::verify_sample(scene, env.octree(), env.plie(), 8, 4, 1);
         }
     });
 }
@@ -168,11 +168,10 @@ pub fn plie_seed() -> &'static (Scene, Vec<u8>) {
     SEED.get_or_init(|| {
         let scene = plie::scene::builtin::load("cornell-cube-1").expect("built-in scene");
         let params = plie::lie::PlieParams { grids: plie::lie::Grids::Build, ..plie::lie::PlieParams::thesis() };
-        let octree = Octree::build(&scene, params.octree()).expect("valid octree parameters");
-        let built = plie::construct::build_refined(&scene, octree, params, &plie::NoProgress);
+        let (env, _) = Environment::build(&scene, &params).expect("valid parameters");
         let dir = tempfile::tempdir().expect("a temporary folder");
         let path = dir.path().join("seed.plie");
-        save_plie(&path, &scene, &built.octree, &built.plie).expect("save the seed");
+        env.save(&path, &scene).expect("save the seed");
         let bytes = std::fs::read(&path).expect("read the seed");
         (scene, bytes)
     })

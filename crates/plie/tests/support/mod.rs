@@ -87,29 +87,34 @@ pub fn builtins() -> Vec<Scene> {
     plie::scene::builtin::NAMES.iter().map(|n| plie::scene::builtin::load(n).unwrap()).collect()
 }
 
-/// Every structure a visibility mode may need, built for one scene.
+/// Every structure a visibility mode may need, built for one scene: its P-LIE environment (with
+/// face grids) and the scene BVH.
 pub struct Built {
     pub bvh: plie::visibility::bvh::Bvh,
-    pub octree: plie::octree::Octree,
-    pub plie: plie::lie::Plie,
+    pub env: plie::Environment,
 }
 
 impl Built {
     /// Built with `params` plus face grids, refining the octree if `params.refine` asks.
     pub fn refined(scene: &Scene, params: plie::lie::PlieParams) -> Built {
-        let params = plie::lie::PlieParams { grids: plie::lie::Grids::Build, ..params };
-        let bvh = plie::visibility::bvh::Bvh::build(scene);
-        let octree = plie::octree::Octree::build(scene, params.octree()).expect("valid octree parameters");
-        let b = plie::construct::build_refined(scene, octree, params, &plie::render::NoProgress);
-        Built { bvh, octree: b.octree, plie: b.plie }
+        Built::new(scene, params)
     }
 
     pub fn new(scene: &Scene, params: plie::lie::PlieParams) -> Built {
         let params = plie::lie::PlieParams { grids: plie::lie::Grids::Build, ..params };
         let bvh = plie::visibility::bvh::Bvh::build(scene);
-        let octree = plie::octree::Octree::build(scene, params.octree()).expect("valid octree parameters");
-        let (plie, _) = plie::construct::build(scene, &octree, params, &plie::render::NoProgress);
-        Built { bvh, octree, plie }
+        let (env, _) = plie::Environment::build(scene, &params).expect("valid parameters");
+        Built { bvh, env }
+    }
+
+    /// The octree (refined if the parameters asked for refinement).
+    pub fn octree(&self) -> &Octree {
+        self.env.octree()
+    }
+
+    /// The P-LIE.
+    pub fn plie(&self) -> &plie::lie::Plie {
+        self.env.plie()
     }
 
     pub fn vis<'a>(
@@ -117,8 +122,30 @@ impl Built {
         scene: &'a Scene,
         mode: plie::visibility::Mode,
     ) -> Box<dyn plie::visibility::Visibility + 'a> {
-        plie::visibility::for_mode(mode, scene, &self.bvh, &self.octree, Some(&self.plie)).unwrap()
+        self.env.visibility(mode, scene).unwrap()
     }
+}
+
+/// The construction (stages 1-7) on a given octree, without limits: what the tests that compare
+/// builds on one octree need (users call [`plie::Environment::build`]).
+pub fn construct(scene: &Scene, octree: &Octree, params: plie::lie::PlieParams) -> plie::construct::Built {
+    plie::construct::build_bounded(scene, octree.clone(), params, Default::default(), &plie::NoProgress)
+        .expect("not cancelled")
+}
+
+/// The pixels `vis` renders: direct light, `settings`, `camera`, hits from `bvh` (leaves from
+/// `octree` if given).
+pub fn render(
+    scene: &Scene,
+    camera: &plie::Camera,
+    settings: &plie::RenderSettings,
+    bvh: &plie::visibility::bvh::Bvh,
+    octree: Option<&Octree>,
+    vis: &dyn plie::Visibility,
+) -> Vec<Vec3> {
+    let renderer = plie::Renderer::new().settings(*settings).camera(*camera);
+    renderer.validate().expect("valid settings");
+    renderer.render_with(scene, bvh, octree, vis).expect("rendered").pixels
 }
 
 /// A shading-like start point: on a triangle, on a leaf's face/edge/corner, or anywhere.
