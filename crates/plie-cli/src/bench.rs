@@ -11,15 +11,15 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use anyhow::{Context, Result};
-use plie::construct::refine::RefineParams;
-use plie::lie::{Grids, PlieParams, Propagation, Regions};
+use plie::internals::render::shade::shade;
+use plie::internals::render::{HitBuffer, NoProgress, Progress};
 use plie::octree::Octree;
-use plie::render::shade::shade;
-use plie::render::{HitBuffer, NoProgress, Progress};
 use plie::scene::builtin;
 use plie::visibility::bvh::Bvh;
 use plie::visibility::{self, Mode};
+use plie::RefineParams;
 use plie::{Camera, Environment, Scene, Shadows};
+use plie::{Grids, PlieParams, Propagation, Regions};
 
 use crate::bench_data::{median, BreakEven, BuildResult, Plan, Results, SceneResult, Shading};
 use crate::progress::Bar;

@@ -11,11 +11,11 @@
 use std::path::Path;
 
 use anyhow::{Context, Result};
-use plie::lie::PlieParams;
-use plie::render::path::{Nee, PathSettings};
-use plie::render::{Progress, RenderSettings};
 use plie::visibility::Mode;
+use plie::PlieParams;
 use plie::{Camera, Environment, Integrator, Renderer, Shadows, Timing};
+use plie::{Nee, PathSettings};
+use plie::{Progress, RenderSettings};
 use serde::Serialize;
 
 use crate::progress::Bar;

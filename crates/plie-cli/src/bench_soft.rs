@@ -11,13 +11,13 @@ use std::path::Path;
 use std::time::Instant;
 
 use anyhow::{Context, Result};
-use plie::construct::refine::RefineParams;
-use plie::lie::PlieParams;
-use plie::render::cpu_time::process_cpu_seconds;
-use plie::render::shade::shade;
-use plie::render::{HitBuffer, NoProgress};
+use plie::internals::render::cpu_time::process_cpu_seconds;
+use plie::internals::render::shade::shade;
+use plie::internals::render::{HitBuffer, NoProgress};
 use plie::scene::builtin;
 use plie::visibility::{LightAnswers, Mode, QueryCtx, ShadowRay, Visibility};
+use plie::PlieParams;
+use plie::RefineParams;
 use plie::{Camera, Environment, Scene, Shadows};
 use serde::Serialize;
 
@@ -164,7 +164,10 @@ pub fn run(scenes: &[String], out: &Path, runs: usize, quiet: bool) -> Result<()
                 let differing = match col {
                     Column::Mode(m) if m != Mode::None && !m.is_exact() => {
                         let bvh_vis = shadows.visibility(Mode::Bvh)?;
-                        Some(plie::compare::answer_diff(&scene, hits, vis.as_ref(), bvh_vis.as_ref(), n, 1).differing)
+                        Some(
+                            plie::internals::compare::answer_diff(&scene, hits, vis.as_ref(), bvh_vis.as_ref(), n, 1)
+                                .differing,
+                        )
                     }
                     _ => None,
                 };

@@ -1,13 +1,13 @@
 //! `plie build --memory-budget` (issue 15): the memory budget of the P-LIE construction, its default
 //! (a safe fraction of the machine's memory), and the peak memory the build reports (VmHWM).
 //!
-//! The library takes a budget for the blocker lists alone ([`plie::construct::Limits`]); the rest of a
+//! The library takes a budget for the blocker lists alone ([`plie::BuildOptions::list_bytes`]); the rest of a
 //! build (scene, octree, BVH-free construction scratch, region triangles) is estimated per triangle
 //! here, and the lists get half of what remains, because flattening them into the P-LIE's arrays
 //! briefly holds a second copy.
 
 use anyhow::{bail, Result};
-use plie::construct::BuildStats;
+use plie::BuildStats;
 use plie::Scene;
 
 use crate::progress::Bar;

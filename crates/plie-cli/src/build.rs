@@ -71,7 +71,7 @@ pub fn run(a: &Args) -> Result<()> {
     let memory = plie.memory_bytes() + octree.memory_bytes();
     if a.json {
         let propagation = json!({
-            "enabled": params.propagation == plie::lie::Propagation::On,
+            "enabled": params.propagation == plie::Propagation::On,
             "records_removed": stats.records_removed_propagation,
             "tests": stats.propagation_tests,
             "by_rule": stats.propagation_by_rule,
@@ -234,7 +234,7 @@ pub fn run(a: &Args) -> Result<()> {
 }
 
 /// The summary lines of refinement (SPEC §4.8): leaves added per criterion, and what it changed.
-fn print_refinement(params: &plie::lie::PlieParams, stats: &plie::construct::BuildStats) {
+fn print_refinement(params: &plie::PlieParams, stats: &plie::BuildStats) {
     let (Some(u), true) = (stats.unrefined, params.refine.enabled()) else {
         println!("refinement      none (--refine to enable)");
         return;

@@ -2,7 +2,7 @@
 //! shared by `plie render` and `plie inspect` (SPEC §2's hit buffer and N-rooks shadow rays).
 
 use anyhow::{bail, Result};
-use plie::render::RenderSettings;
+use plie::RenderSettings;
 use plie::Scene;
 
 /// Options that set the rendered image.

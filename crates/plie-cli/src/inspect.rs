@@ -7,10 +7,10 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context, Result};
 use glam::Vec3;
-use plie::inspect::overlay::{camera_on_box, render_inspection, OverlayStyle};
-use plie::inspect::summary::{FaceSummary, Filter, Summary};
-use plie::inspect::{FaceStatus, Inspection, Inspector};
-use plie::io::gltf_export::{save_inspection_gltf, GltfFormat};
+use plie::internals::inspect::overlay::{camera_on_box, render_inspection, OverlayStyle};
+use plie::internals::inspect::summary::{FaceSummary, Filter, Summary};
+use plie::internals::inspect::{FaceStatus, Inspection, Inspector};
+use plie::internals::io::gltf_export::{save_inspection_gltf, GltfFormat};
 use plie::octree::{Dir, Octree};
 use serde_json::{json, Value};
 

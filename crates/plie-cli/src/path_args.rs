@@ -3,7 +3,7 @@
 //! point 6), and how many samples each takes.
 
 use anyhow::{bail, Result};
-use plie::render::path::{Nee, PathSettings};
+use plie::{Nee, PathSettings};
 
 /// Which estimator renders the image.
 #[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]

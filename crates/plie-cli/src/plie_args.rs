@@ -8,11 +8,11 @@ use std::time::Instant;
 use anyhow::{bail, Context, Result};
 use clap::parser::ValueSource;
 use clap::ArgMatches;
-use plie::construct::refine::{MaxBlockers, RefineParams};
-use plie::lie::{Grids, PlieParams, Propagation, Regions};
 use plie::octree::OctreeParams;
 use plie::Scene;
 use plie::{BuildOptions, Environment};
+use plie::{Grids, PlieParams, Propagation, Regions};
+use plie::{MaxBlockers, RefineParams};
 
 use crate::progress::Bar;
 
@@ -57,7 +57,7 @@ pub struct PlieArgs {
     pub max_blockers: Option<MaxBlockers>,
     /// P-LIE: most blockers a record stores, or `none`; a record with more stores no list and its
     /// rays are answered by the scene BVH (exact either way). Bounds construction time and memory.
-    #[arg(long, value_name = "N|none", default_value_t = BlockerCap(Some(plie::lie::DEFAULT_BLOCKER_CAP)), value_parser = parse_blocker_cap)]
+    #[arg(long, value_name = "N|none", default_value_t = BlockerCap(Some(plie::DEFAULT_BLOCKER_CAP)), value_parser = parse_blocker_cap)]
     pub blocker_cap: BlockerCap,
 }
 

@@ -8,7 +8,7 @@ use std::sync::Mutex;
 use std::time::{Duration, Instant};
 
 use indicatif::{ProgressBar, ProgressStyle};
-use plie::render::Progress;
+use plie::Progress;
 
 /// Interval of the one-line progress when stderr is not a terminal.
 const LINE_EVERY: Duration = Duration::from_secs(10);

@@ -3,9 +3,9 @@
 //! (rays by kind, time in shadow tests, shadow rays per second, the cost of locating path vertices).
 
 use anyhow::{Context, Result};
-use plie::render::path::PathStats;
-use plie::render::RenderSettings;
 use plie::visibility::QueryStats;
+use plie::PathStats;
+use plie::RenderSettings;
 use plie::{Image, Timing};
 use serde_json::json;
 

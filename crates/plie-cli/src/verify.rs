@@ -1,5 +1,5 @@
 //! `plie verify FILE.plie --scene S [--full]`: checks a P-LIE file against a rebuild (SPEC §4), for
-//! files that pass the checksum but may have been altered (`plie::verify`).
+//! files that pass the checksum but may have been altered (`plie::internals::verify`).
 
 use std::path::PathBuf;
 use std::time::Instant;
@@ -41,9 +41,9 @@ pub fn run(a: &Args) -> Result<()> {
         .with_context(|| format!("cannot use P-LIE file {}", a.file.display()))?;
     let (octree, plie) = (env.octree(), env.plie());
     let report = if a.full {
-        plie::verify::verify_full(&scene, plie)
+        plie::internals::verify::verify_full(&scene, plie)
     } else {
-        plie::verify::verify_sample(&scene, octree, plie, a.records as usize, a.rays as usize, a.seed)
+        plie::internals::verify::verify_sample(&scene, octree, plie, a.records as usize, a.rays as usize, a.seed)
     };
     match report {
         Ok(r) if a.full => {

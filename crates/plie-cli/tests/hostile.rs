@@ -395,7 +395,7 @@ fn verify_finds_a_corrupted_p_lie_with_a_valid_checksum() {
     let mut b = std::fs::read(&file).unwrap();
     assert!(b[347..398].iter().any(|&x| x != 0), "the bytes change");
     b[347..398].fill(0);
-    let sum = plie::io::plie_file::checksum(&b[28..]);
+    let sum = plie::internals::io::plie_file::checksum(&b[28..]);
     b[20..28].copy_from_slice(&sum.to_le_bytes());
     let bad = write(dir.path(), "bad.plie", &b);
     let o = plie_checked(&["verify", s(&bad), "--scene", "cornell-cube-1", "--full"], &[&bad]);
@@ -404,7 +404,7 @@ fn verify_finds_a_corrupted_p_lie_with_a_valid_checksum() {
     let mut junk = b[..28].to_vec();
     junk.extend([0xffu8; 64]);
     junk[12..20].copy_from_slice(&64u64.to_le_bytes());
-    let sum = plie::io::plie_file::checksum(&junk[28..]);
+    let sum = plie::internals::io::plie_file::checksum(&junk[28..]);
     junk[20..28].copy_from_slice(&sum.to_le_bytes());
     let junk = write(dir.path(), "junk.plie", &junk);
     let o = plie(&["verify", s(&junk), "--scene", "cornell-cube-1"]);

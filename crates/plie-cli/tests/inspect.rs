@@ -8,11 +8,11 @@ use std::path::Path;
 
 use glam::Vec3;
 use plie::geometry::Aabb;
-use plie::inspect::{BLOCKER_COLOUR, HIGHLIGHT_COLOUR, PENUMBRA_COLOUR, UMBRA_COLOUR};
+use plie::internals::inspect::{BLOCKER_COLOUR, HIGHLIGHT_COLOUR, PENUMBRA_COLOUR, UMBRA_COLOUR};
 use plie::io::image::srgb_encode;
-use plie::lie::PlieParams;
 use plie::octree::Octree;
 use plie::Camera;
+use plie::PlieParams;
 use support::{fails_with, plie, stderr};
 
 /// `X,Y,Z` of a point.

@@ -8,7 +8,7 @@ use std::sync::OnceLock;
 use std::time::Instant;
 
 use glam::Vec3;
-use plie::construct::refine::{MaxBlockers, RefineParams};
+use plie::{MaxBlockers, RefineParams};
 pub use plie::io::camera_path::CameraPath;
 use plie::octree::{Octree, OctreeParams};
 use plie::visibility::bvh::Bvh;
@@ -108,7 +108,7 @@ impl Default for BuildOptions {
             refine: Vec::new(),
             max_split_depth: 2,
             max_blockers: None,
-            blocker_cap: Some(plie::lie::DEFAULT_BLOCKER_CAP),
+            blocker_cap: Some(plie::DEFAULT_BLOCKER_CAP),
         }
     }
 }

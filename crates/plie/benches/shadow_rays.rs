@@ -8,7 +8,7 @@
 use std::time::Instant;
 
 use glam::Vec2;
-use plie::lie::PlieParams;
+use plie::internals::lie::PlieParams;
 use plie::octree::Octree;
 use plie::visibility::{Mode, QueryCtx, ShadowRay};
 use plie::{Environment, LightId, Scene, TriId};

@@ -3,7 +3,7 @@
 //!
 //! `cargo run --release -p plie --example build_save_load [SCENE]`
 
-use plie::lie::RefineParams;
+use plie::RefineParams;
 use plie::{Environment, PlieFileError, PlieParams};
 
 fn main() -> plie::Result<()> {

@@ -4,7 +4,7 @@
 //! Prints per variant the least process CPU time (from /proc/self/stat, 10 ms ticks; less disturbed
 //! by other processes than wall time on a shared machine) and the least wall time, and the occluded
 //! count. `none` and `bvh` are measured alongside for scale. Last, how many of the default native
-//! Embree's answers differ from `bvh`'s (exact) over the same shadow rays ([`plie::compare`]).
+//! Embree's answers differ from `bvh`'s (exact) over the same shadow rays ([`plie::internals::compare`]).
 //!
 //! ```text
 //! cargo run --release -p plie --features embree --example embree_packets -- SCENE [SHADOW_RAYS] [RUNS]
@@ -15,8 +15,8 @@
 use std::time::Instant;
 
 use glam::Vec3;
-use plie::render::shade::shade;
-use plie::render::{HitBuffer, NoProgress};
+use plie::internals::render::shade::shade;
+use plie::internals::render::{HitBuffer, NoProgress};
 use plie::visibility::bvh::Bvh;
 use plie::visibility::embree::native::{Exclusion, NativeEmbree, Packet};
 use plie::visibility::{BvhVisibility, NoVisibility, Visibility};
@@ -87,7 +87,7 @@ fn main() {
             scene.triangle_count()
         );
         let native = NativeEmbree::new(&scene).expect("Embree device");
-        let diff = plie::compare::answer_diff(&scene, &hits, &native, variants[1].1.as_ref(), rays, 1);
+        let diff = plie::internals::compare::answer_diff(&scene, &hits, &native, variants[1].1.as_ref(), rays, 1);
         println!(
             "embree (default) against bvh: {} of {} answers differ ({:.2e})",
             diff.differing,

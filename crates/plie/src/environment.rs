@@ -94,8 +94,8 @@ impl Environment {
         Ok((Environment::from_parts(scene, built.octree, built.plie), stats))
     }
 
-    /// An environment of an octree and a P-LIE built on it for `scene` (as [`crate::construct`]
-    /// returns them).
+    /// An environment of an octree and a P-LIE built on it for `scene` (as the construction returns
+    /// them; for the crate's tests and tools).
     pub fn from_parts(scene: &Scene, octree: Octree, plie: Plie) -> Environment {
         Environment { octree, plie, scene_fingerprint: plie_file::scene_fingerprint(scene), bvh: OnceLock::new() }
     }

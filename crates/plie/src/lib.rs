@@ -56,25 +56,78 @@ pub mod environment;
 pub mod error;
 pub mod geometry;
 pub mod io;
+pub mod octree;
+pub mod progress;
+pub mod renderer;
 pub mod scene;
+pub mod visibility;
 
-pub use construct::BuildStats;
+pub(crate) mod compare;
+pub(crate) mod construct;
+pub(crate) mod inspect;
+pub(crate) mod lie;
+pub(crate) mod render;
+pub(crate) mod verify;
+
+pub use construct::{BuildStats, RoundStats};
 pub use environment::{BuildOptions, Environment, Report};
 pub use error::{Error, PlieFileError, Result};
-pub use lie::{Grids, PlieParams, Propagation, Regions};
+pub use lie::{Criterion, Grids, MaxBlockers, PlieParams, Propagation, RefineParams, Regions, DEFAULT_BLOCKER_CAP};
 pub use progress::{NoProgress, Progress};
-pub use render::path::{Nee, PathSettings};
+pub use render::path::{Nee, PathSettings, PathStats};
 pub use render::RenderSettings;
 pub use renderer::{Image, Integrator, Renderer, Timing};
 pub use scene::{Camera, Light, LightId, Material, MaterialId, Scene, SceneBuilder, TriId};
-pub use visibility::{Mode, Shadows, Visibility};
-pub mod compare;
-pub mod construct;
-pub mod inspect;
-pub mod lie;
-pub mod octree;
-pub mod progress;
-pub mod render;
-pub mod renderer;
-pub mod verify;
-pub mod visibility;
+pub use visibility::{Mode, QueryCtx, QueryStats, ShadowRay, Shadows, Visibility};
+
+/// The library's internal stages, for its own tests, benchmarks and fuzz targets and for the tools
+/// of the `plie` command that look inside a P-LIE (`plie bench`, `plie inspect`, `plie verify`).
+///
+/// **Not a stable API**: anything here may change or go away in any release. Programs that use plie
+/// need only the items at the crate root ([`Environment`], [`Renderer`], [`Shadows`],
+/// [`Visibility`] and what they take and return).
+#[doc(hidden)]
+pub mod internals {
+    /// Comparing one mode's shadow-ray answers with another's.
+    pub mod compare {
+        pub use crate::compare::*;
+    }
+    /// The P-LIE construction's stages.
+    pub mod construct {
+        pub use crate::construct::*;
+    }
+    /// What `plie inspect` shows of a cell.
+    pub mod inspect {
+        pub use crate::inspect::*;
+    }
+    /// The P-LIE data structure and its vocabulary.
+    pub mod lie {
+        pub use crate::lie::*;
+    }
+    /// The renderer's passes: hit buffer, shading, path tracing.
+    pub mod render {
+        pub use crate::render::*;
+    }
+    /// Checking a P-LIE file against a rebuild.
+    pub mod verify {
+        pub use crate::verify::*;
+    }
+    /// `.plie` files and the glTF export of `plie inspect`.
+    pub mod io {
+        /// The glTF scene `plie inspect` writes.
+        pub mod gltf_export {
+            pub use crate::io::gltf_export::*;
+        }
+        /// The `.plie` file format.
+        pub mod plie_file {
+            pub use crate::io::plie_file::*;
+        }
+    }
+    /// The P-LIE modes' query internals.
+    pub mod visibility {
+        /// The P-LIE modes.
+        pub mod lie {
+            pub use crate::visibility::lie::exit_face;
+        }
+    }
+}

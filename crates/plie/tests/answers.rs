@@ -6,9 +6,9 @@
 mod support;
 
 use glam::Vec2;
-use plie::lie::PlieParams;
-use plie::render::shade::shade;
-use plie::render::{HitBuffer, NoProgress};
+use plie::internals::lie::PlieParams;
+use plie::internals::render::shade::shade;
+use plie::internals::render::{HitBuffer, NoProgress};
 use plie::visibility::{Answer, Mode, QueryCtx, QueryStats, ShadowRay};
 use plie::{LightId, Scene, TriId};
 use support::{Built, TestRng};

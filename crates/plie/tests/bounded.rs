@@ -5,10 +5,10 @@
 
 mod support;
 
-use plie::construct::{build_bounded, Interrupted, Limits};
-use plie::lie::{Cell, PlieParams, RecordKind};
+use plie::internals::construct::{build_bounded, Interrupted, Limits};
+use plie::internals::lie::{Cell, PlieParams, RecordKind};
+use plie::internals::render::{NoProgress, Progress};
 use plie::octree::Octree;
-use plie::render::{NoProgress, Progress};
 use plie::visibility::{Brute, Mode, QueryCtx, Visibility};
 use plie::{Environment, Scene};
 
@@ -17,7 +17,7 @@ fn balusters() -> Scene {
     plie::scene::builtin::load("balusters-12").unwrap()
 }
 
-fn build(scene: &Scene, params: PlieParams, limits: Limits) -> plie::construct::Built {
+fn build(scene: &Scene, params: PlieParams, limits: Limits) -> plie::internals::construct::Built {
     build_bounded(
         scene,
         Octree::build(scene, params.octree()).expect("valid octree parameters"),
@@ -30,7 +30,7 @@ fn build(scene: &Scene, params: PlieParams, limits: Limits) -> plie::construct::
 
 /// Every exact P-LIE mode against brute force on `n` shadow rays; returns the rays answered by the
 /// scene BVH (summed over the modes).
-fn check_exact(scene: &Scene, built: &plie::construct::Built, n: usize) -> u64 {
+fn check_exact(scene: &Scene, built: &plie::internals::construct::Built, n: usize) -> u64 {
     let env = Environment::from_parts(scene, built.octree.clone(), built.plie.clone());
     let brute = Brute::new(scene);
     let rays = support::shadow_rays(scene, &built.octree, n, 15);

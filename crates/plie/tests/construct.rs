@@ -6,9 +6,9 @@
 //!   matters for the image.
 
 use glam::{Vec2, Vec3};
-use plie::construct::data_objects::{face_sees_light, thesis_face_sees_light};
 use plie::geometry::RayTest;
-use plie::lie::{PlieParams, Regions};
+use plie::internals::construct::data_objects::{face_sees_light, thesis_face_sees_light};
+use plie::internals::lie::{PlieParams, Regions};
 use plie::octree::{Dir, LeafId, Octree};
 use plie::visibility::Mode;
 use plie::{LightId, Scene, SceneBuilder};
@@ -67,7 +67,7 @@ fn hits_any_t(scene: &Scene, a: Vec3, b: Vec3, t: usize) -> bool {
 
 /// The P-LIE of `scene` built with `params` by [`plie::Environment::build`], which builds the same
 /// `octree` (checked).
-fn build_on(scene: &Scene, octree: &Octree, params: PlieParams) -> (plie::lie::Plie, plie::BuildStats) {
+fn build_on(scene: &Scene, octree: &Octree, params: PlieParams) -> (plie::internals::lie::Plie, plie::BuildStats) {
     let (env, stats) = plie::Environment::build(scene, &params).unwrap();
     assert!(env.octree() == octree, "the environment's octree is the one of its parameters");
     (env.into_parts().1, stats)
@@ -166,7 +166,7 @@ fn thesis_dot_product_rule_drops_a_needed_record() {
 
 #[test]
 fn lie_mode_matches_brute_force_in_the_room() {
-    use plie::visibility::{Brute, LieVisibility, QueryCtx, ShadowRay, Visibility};
+    use plie::visibility::{Brute, QueryCtx, ShadowRay, Visibility};
     let scene = room();
     for max_triangles in [8, 200] {
         let params = PlieParams { max_triangles, ..PlieParams::default() };
@@ -174,8 +174,8 @@ fn lie_mode_matches_brute_force_in_the_room() {
         let (plie, stats) = build_on(&scene, &octree, params);
         assert!(stats.grids > 0);
         let brute = Brute::new(&scene);
-        let bvh = plie::visibility::bvh::Bvh::build(&scene);
-        let modes = PLIE_MODES.map(|m| (m, LieVisibility::new(&scene, &bvh, &octree, &plie, m)));
+        let env = plie::Environment::from_parts(&scene, octree.clone(), plie.clone());
+        let modes = PLIE_MODES.map(|m| (m, env.visibility(m, &scene).unwrap()));
         let mut ctx = QueryCtx::new(scene.triangles.len());
         let mut rng = Rng(5);
         let light = &scene.lights[0];
@@ -207,7 +207,7 @@ fn lie_mode_matches_brute_force_in_the_room() {
 
 #[test]
 fn lie_mode_matches_brute_force_with_lights_tilted_to_grazing() {
-    use plie::visibility::{Brute, LieVisibility, QueryCtx, ShadowRay, Visibility};
+    use plie::visibility::{Brute, QueryCtx, ShadowRay, Visibility};
     // The room plus five lights whose normals are tilted from straight down to grazing (89.9 degrees).
     let base = room();
     let mut b = SceneBuilder::new("tilted");
@@ -235,8 +235,8 @@ fn lie_mode_matches_brute_force_with_lights_tilted_to_grazing() {
     let octree = Octree::build(&scene, params.octree()).expect("valid octree parameters");
     let (plie, _) = build_on(&scene, &octree, params);
     let brute = Brute::new(&scene);
-    let bvh = plie::visibility::bvh::Bvh::build(&scene);
-    let modes = PLIE_MODES.map(|m| (m, LieVisibility::new(&scene, &bvh, &octree, &plie, m)));
+    let env = plie::Environment::from_parts(&scene, octree.clone(), plie.clone());
+    let modes = PLIE_MODES.map(|m| (m, env.visibility(m, &scene).unwrap()));
     let mut ctx = QueryCtx::new(scene.triangles.len());
     let mut rng = Rng(17);
     let (mut n, mut blocked) = (0, 0);
@@ -288,7 +288,7 @@ fn construction_does_not_depend_on_the_thread_count() {
 
 #[test]
 fn grid_cells_contain_every_triangle_between_cell_and_light() {
-    use plie::construct::grid::cell_box;
+    use plie::internals::construct::grid::cell_box;
     let scene = room();
     let params = PlieParams { max_triangles: 64, ..PlieParams::default() };
     let octree = Octree::build(&scene, params.octree()).expect("valid octree parameters");
@@ -304,7 +304,7 @@ fn grid_cells_contain_every_triangle_between_cell_and_light() {
         let leaf = octree.leaf_bounds(r.leaf);
         for j in 0..g.res {
             for i in 0..g.res {
-                let plie::lie::Cell::Blockers(list) = plie.cell(g, (j * g.res + i) as usize) else {
+                let plie::internals::lie::Cell::Blockers(list) = plie.cell(g, (j * g.res + i) as usize) else {
                     continue; // Umbra cells: tests/regions.rs.
                 };
                 let q = r.face.face_corners(&cell_box(r.face, &leaf, g.res, i, j));

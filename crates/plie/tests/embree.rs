@@ -7,8 +7,8 @@
 mod support;
 
 use glam::Vec3;
-use plie::compare::answer_diff;
-use plie::render::{HitBuffer, RenderSettings};
+use plie::internals::compare::answer_diff;
+use plie::internals::render::{HitBuffer, RenderSettings};
 use plie::visibility::bvh::Bvh;
 use plie::visibility::embree::native::{Exclusion, Packet};
 use plie::visibility::{Brute, BvhVisibility, NativeEmbree, Visibility};

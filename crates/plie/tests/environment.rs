@@ -3,13 +3,12 @@
 //! same pixels as the stages called by hand; bad parameters and bad files are typed errors, never
 //! panics.
 
-use plie::construct::refine::RefineParams;
+use plie::internals::construct::refine::RefineParams;
+use plie::internals::render::path::{render_path, Nee, PathSettings};
+use plie::internals::render::shade::shade;
+use plie::internals::render::{HitBuffer, NoProgress, RenderSettings};
 use plie::octree::{Octree, OctreeParams};
-use plie::render::path::{render_path, Nee, PathSettings};
-use plie::render::shade::shade;
-use plie::render::{HitBuffer, NoProgress, RenderSettings};
 use plie::visibility::bvh::Bvh;
-use plie::visibility::LieVisibility;
 use plie::{Environment, Error, Integrator, Mode, PlieFileError, PlieParams, Propagation, Regions, Renderer, Shadows};
 
 fn bits(p: &[glam::Vec3]) -> Vec<[u32; 3]> {
@@ -22,7 +21,8 @@ fn build_includes_refinement_and_equals_the_stages() {
     let params = PlieParams { refine: RefineParams::thesis_umbra(), ..PlieParams::default() };
     let (env, stats) = Environment::build(&scene, &params).unwrap();
     let octree = Octree::build(&scene, params.octree()).unwrap();
-    let built = plie::construct::build_bounded(&scene, octree, params, Default::default(), &NoProgress).unwrap();
+    let built =
+        plie::internals::construct::build_bounded(&scene, octree, params, Default::default(), &NoProgress).unwrap();
     assert!(stats.refine_rounds > 0, "cornell-cube-4 refines by umbra");
     assert_eq!(env.plie(), &built.plie);
     assert_eq!(env.octree(), &built.octree);
@@ -129,10 +129,10 @@ fn the_renderer_gives_the_pixels_of_the_stages_called_by_hand() {
     let settings = RenderSettings { width: 24, height: 16, eye_rays: 1, shadow_rays: 4, seed: 3 };
     let camera = scene.camera_or_default();
     let bvh = Bvh::build(&scene);
-    let by_hand_vis = LieVisibility::new(&scene, &bvh, env.octree(), env.plie(), Mode::Grid);
+    let by_hand_vis = env.visibility(Mode::Grid, &scene).unwrap();
     let size = (settings.width, settings.height, settings.eye_rays);
     let hits = HitBuffer::build(&scene, &camera, size, &bvh, Some(env.octree()));
-    let by_hand = shade(&scene, &hits, &by_hand_vis, settings.shadow_rays, settings.seed, &NoProgress).0;
+    let by_hand = shade(&scene, &hits, by_hand_vis.as_ref(), settings.shadow_rays, settings.seed, &NoProgress).0;
     let renderer = Renderer::new().settings(settings);
     let grid = renderer.render(&scene, Mode::Grid, Some(&env)).unwrap();
     assert_eq!(bits(&grid.pixels), bits(&by_hand));

@@ -9,7 +9,7 @@
 
 mod support;
 
-use plie::lie::PlieParams;
+use plie::internals::lie::PlieParams;
 use plie::octree::Octree;
 use plie::visibility::{Mode, QueryCtx, ShadowRay};
 use plie::{LightId, Scene};

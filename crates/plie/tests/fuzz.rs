@@ -91,7 +91,7 @@ struct Rng(u64);
 impl Rng {
     fn next(&mut self) -> u64 {
         self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
-        plie::render::sampler::mix64(self.0)
+        plie::internals::render::sampler::mix64(self.0)
     }
 
     fn below(&mut self, n: usize) -> usize {

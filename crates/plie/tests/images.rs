@@ -4,8 +4,8 @@
 mod support;
 
 use glam::Vec3;
-use plie::lie::PlieParams;
-use plie::render::RenderSettings;
+use plie::internals::lie::PlieParams;
+use plie::internals::render::RenderSettings;
 use plie::visibility::Mode;
 use plie::Scene;
 use support::Built;

@@ -3,17 +3,17 @@
 //! overlay picture shades the scene exactly as `render` does (markers cast no shadows).
 
 use glam::Vec3;
-use plie::inspect::overlay::{overlay_scene, render_inspection, OverlayStyle};
-use plie::inspect::summary::Filter;
-use plie::inspect::{FaceStatus, Inspector};
-use plie::lie::{Plie, PlieParams, Regions};
+use plie::internals::inspect::overlay::{overlay_scene, render_inspection, OverlayStyle};
+use plie::internals::inspect::summary::Filter;
+use plie::internals::inspect::{FaceStatus, Inspector};
+use plie::internals::lie::{Plie, PlieParams, Regions};
+use plie::internals::render::{HitBuffer, NoProgress, RenderSettings};
 use plie::octree::{Dir, Octree};
-use plie::render::{HitBuffer, NoProgress, RenderSettings};
 use plie::visibility::bvh::Bvh;
 use plie::visibility::BvhVisibility;
 use plie::{LightId, Scene};
 
-fn build(scene: &Scene, params: PlieParams) -> (Octree, Plie, plie::construct::BuildStats) {
+fn build(scene: &Scene, params: PlieParams) -> (Octree, Plie, plie::internals::construct::BuildStats) {
     let (env, stats) = plie::Environment::build(scene, &params).unwrap();
     let (octree, plie) = env.into_parts();
     (octree, plie, stats)
@@ -34,7 +34,7 @@ fn statuses_and_summary_agree_with_the_builder() {
         assert_eq!(s.cannot_see_light, stats.no_record_face_cannot_see_light, "{}", scene.name);
         // Fractions summed from the stored triangles match the builder's polygon areas.
         let rows: Vec<_> = s.leaves.iter().flat_map(|l| &l.faces).filter(|f| f.blockers.is_some()).collect();
-        let mean = |get: fn(&plie::inspect::summary::FaceSummary) -> f64| {
+        let mean = |get: fn(&plie::internals::inspect::summary::FaceSummary) -> f64| {
             rows.iter().map(|f| get(f)).sum::<f64>() / rows.len() as f64
         };
         let umbra = mean(|f| f.umbra_fraction.unwrap());
@@ -126,7 +126,7 @@ fn bad_points_lights_faces_and_mismatched_p_lies_are_errors() {
     let (octree, plie, _) = build(&scene, PlieParams::default());
     let ins = Inspector::new(&scene, &octree, &plie).unwrap();
     let c = octree.root_bounds().center();
-    let msg = |r: plie::Result<plie::inspect::Inspection>| r.unwrap_err().to_string();
+    let msg = |r: plie::Result<plie::internals::inspect::Inspection>| r.unwrap_err().to_string();
     assert!(msg(ins.inspect(Vec3::splat(1e7), LightId(0), None)).contains("outside the octree"));
     assert!(msg(ins.inspect(Vec3::NAN, LightId(0), None)).contains("outside the octree"));
     assert!(msg(ins.inspect(c, LightId(1), None)).contains("light 1 does not exist"));

@@ -7,7 +7,7 @@
 mod support;
 
 use glam::{Vec2, Vec3};
-use plie::lie::PlieParams;
+use plie::internals::lie::PlieParams;
 use plie::visibility::{LightRays, Mode, QueryCtx};
 use plie::{LightId, Scene, TriId};
 use proptest::prelude::*;
@@ -108,10 +108,10 @@ fn per_light_answers_equal_per_ray_and_brute_force_on_shared_scenes() {
 #[test]
 fn per_light_answers_on_a_refined_p_lie() {
     let scene = plie::scene::builtin::load("huis-a").unwrap();
-    let refine = plie::construct::refine::RefineParams {
+    let refine = plie::internals::construct::refine::RefineParams {
         umbra_full: true,
         umbra_free: true,
-        ..plie::construct::refine::RefineParams::none()
+        ..plie::internals::construct::refine::RefineParams::none()
     };
     let params = PlieParams { refine, ..PlieParams::thesis() };
     let built = Built::refined(&scene, params);

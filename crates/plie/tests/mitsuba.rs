@@ -10,9 +10,9 @@ mod support;
 use std::path::{Path, PathBuf};
 
 use glam::{Vec2, Vec3};
+use plie::internals::lie::PlieParams;
+use plie::internals::render::RenderSettings;
 use plie::io::{load_scene, load_scene_with, LoadOptions};
-use plie::lie::PlieParams;
-use plie::render::RenderSettings;
 use plie::scene::texture::srgb_to_linear;
 use plie::visibility::Mode;
 use plie::{Scene, TriId};

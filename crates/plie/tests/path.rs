@@ -5,9 +5,9 @@
 //! and thread counts).
 
 use glam::Vec3;
-use plie::lie::PlieParams;
-use plie::render::path::{Nee, PathSettings, PathStats};
-use plie::render::RenderSettings;
+use plie::internals::lie::PlieParams;
+use plie::internals::render::path::{Nee, PathSettings, PathStats};
+use plie::internals::render::RenderSettings;
 use plie::visibility::{Mode, QueryStats};
 use plie::{Camera, Environment, Integrator, Material, Renderer, Scene, SceneBuilder, Timing, TriId};
 

@@ -5,10 +5,10 @@ mod support;
 
 use std::path::Path;
 
-use plie::io::plie_file::{FORMAT_VERSION, MAGIC};
-use plie::lie::{Plie, PlieParams};
+use plie::internals::io::plie_file::{FORMAT_VERSION, MAGIC};
+use plie::internals::lie::{Plie, PlieParams};
+use plie::internals::render::RenderSettings;
 use plie::octree::Octree;
-use plie::render::RenderSettings;
 use plie::visibility::Mode;
 use plie::{Environment, Renderer, Scene};
 
@@ -33,7 +33,7 @@ fn image(scene: &Scene, octree: &Octree, p: &Plie) -> Vec<[u32; 3]> {
     img.pixels.iter().map(|v| v.to_array().map(f32::to_bits)).collect()
 }
 
-fn err_of(r: plie::Result<(Octree, plie::lie::Plie)>) -> String {
+fn err_of(r: plie::Result<(Octree, plie::internals::lie::Plie)>) -> String {
     match r {
         Ok(_) => panic!("expected an error"),
         Err(e) => e.to_string(),
@@ -127,7 +127,7 @@ fn saving_is_atomic_and_keeps_existing_files_on_error() {
 /// re-checksummed), is an error.
 #[test]
 fn refined_round_trip_and_refinement_mismatch() {
-    use plie::construct::refine::RefineParams;
+    use plie::internals::construct::refine::RefineParams;
     let dir = tempfile::tempdir().unwrap();
     let scene = plie::scene::builtin::load("cornell-cube-5").unwrap();
     let params = PlieParams { refine: RefineParams::thesis_umbra(), ..PlieParams::thesis() };

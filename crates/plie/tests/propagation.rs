@@ -13,11 +13,11 @@
 mod support;
 
 use glam::{Vec2, Vec3};
-use plie::construct::Built;
-use plie::lie::{Plie, PlieParams, Propagation};
+use plie::internals::construct::Built;
+use plie::internals::lie::{Plie, PlieParams, Propagation};
+use plie::internals::render::RenderSettings;
+use plie::internals::visibility::lie::exit_face;
 use plie::octree::{Dir, LeafId, Octree};
-use plie::render::RenderSettings;
-use plie::visibility::lie::exit_face;
 use plie::visibility::{Brute, Mode, QueryCtx, ShadowRay, Visibility};
 use plie::{LightId, Scene, TriId};
 use support::TestRng;
@@ -164,8 +164,10 @@ fn propagated_records_of_refined_p_lies_are_dark() {
     let mut propagated = 0;
     for name in ["huis-a", "huis-c", "boot"] {
         let scene = plie::scene::builtin::load(name).unwrap();
-        let params =
-            PlieParams { refine: plie::construct::refine::RefineParams::thesis_umbra(), ..PlieParams::thesis() };
+        let params = PlieParams {
+            refine: plie::internals::construct::refine::RefineParams::thesis_umbra(),
+            ..PlieParams::thesis()
+        };
         let b = support::construct(
             &scene,
             &Octree::build(&scene, params.octree()).expect("valid octree parameters"),

@@ -8,8 +8,8 @@
 //! faces marked dark by hand.
 
 use glam::{Vec2, Vec3};
-use plie::construct::propagation::{FaceState, FaceStates, Propagated, Propagator, Rule, Tolerances};
 use plie::geometry::Aabb;
+use plie::internals::construct::propagation::{FaceState, FaceStates, Propagated, Propagator, Rule, Tolerances};
 use plie::octree::{Dir, LeafId, Octree, OctreeParams};
 use plie::{LightId, Scene, SceneBuilder};
 
@@ -92,7 +92,7 @@ fn config(coarse_top: bool, c: [i32; 3], x: (f32, f32), y: f32, z: (f32, f32)) -
 
 fn tolerances(cfg: &Config) -> (f32, Tolerances) {
     let root = cfg.octree.root_bounds();
-    let tol = cfg.scene.scale().max(root.size().max_element()) * plie::construct::TOLERANCE_REL;
+    let tol = cfg.scene.scale().max(root.size().max_element()) * plie::internals::construct::TOLERANCE_REL;
     (tol, Tolerances::new(tol, root.min.abs().max(root.max.abs()).max_element()))
 }
 

@@ -3,8 +3,8 @@
 use std::f64::consts::PI;
 
 use glam::{DVec3, Vec3};
-use plie::render::shade::{shade_hit, ShadeScratch};
-use plie::render::Hit;
+use plie::internals::render::shade::{shade_hit, ShadeScratch};
+use plie::internals::render::Hit;
 use plie::visibility::Brute;
 use plie::{SceneBuilder, TriId};
 

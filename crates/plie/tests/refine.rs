@@ -9,10 +9,10 @@
 mod support;
 
 use glam::Vec3;
-use plie::construct::refine::{MaxBlockers, RefineParams};
-use plie::lie::{Grids, PlieParams, Propagation};
+use plie::internals::construct::refine::{MaxBlockers, RefineParams};
+use plie::internals::lie::{Grids, PlieParams, Propagation};
+use plie::internals::render::RenderSettings;
 use plie::octree::Octree;
-use plie::render::RenderSettings;
 use plie::visibility::{Mode, QueryCtx};
 use plie::Scene;
 use rayon::prelude::*;
@@ -167,6 +167,6 @@ fn umbra_refinement_removes_more_dark_records() {
     let plain = support::construct(&scene, &octree, PlieParams::thesis()).stats;
     let b = support::construct(&scene, &octree, refined_params());
     assert!(b.stats.refine_splits.get("umbra_full").copied().unwrap_or(0) > 0, "{:?}", b.stats.refine_splits);
-    let dark = |s: &plie::construct::BuildStats| s.records_removed_umbra + s.records_removed_propagation;
+    let dark = |s: &plie::internals::construct::BuildStats| s.records_removed_umbra + s.records_removed_propagation;
     assert!(dark(&b.stats) > dark(&plain), "refined {} dark records, unrefined {}", dark(&b.stats), dark(&plain));
 }

@@ -5,12 +5,12 @@
 mod support;
 
 use glam::{DVec2, Vec2, Vec3};
-use plie::construct::regions::face_regions;
-use plie::construct::shaft::Shaft;
 use plie::geometry::RayTest;
-use plie::lie::frame::{face_axes, in_triangles, FaceFrame, Tri2, UNITS};
-use plie::lie::grid::cell_box;
-use plie::lie::{Cell, Plie, PlieParams, Propagation, Regions};
+use plie::internals::construct::regions::face_regions;
+use plie::internals::construct::shaft::Shaft;
+use plie::internals::lie::frame::{face_axes, in_triangles, FaceFrame, Tri2, UNITS};
+use plie::internals::lie::grid::cell_box;
+use plie::internals::lie::{Cell, Plie, PlieParams, Propagation, Regions};
 use plie::octree::{Dir, LeafId, Octree};
 use plie::visibility::query::SEGMENT_EPS;
 use plie::{LightId, Scene, SceneBuilder, TriId};

@@ -4,7 +4,7 @@
 mod support;
 
 use glam::Vec3;
-use plie::lie::PlieParams;
+use plie::internals::lie::PlieParams;
 use plie::visibility::{Mode, QueryCtx, ShadowRay};
 use plie::{LightId, SceneBuilder, TriId};
 use support::TestRng;

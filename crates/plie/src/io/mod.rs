@@ -15,14 +15,14 @@
 pub mod atomic;
 pub mod camera_path;
 pub mod gltf;
-pub mod gltf_export;
+pub(crate) mod gltf_export;
 pub mod image;
 pub mod input;
 pub mod lights;
 pub mod mitsuba;
 pub mod obj;
 mod obj_lines;
-pub mod plie_file;
+pub(crate) mod plie_file;
 pub mod ply;
 pub mod serialized;
 pub mod texture_file;

@@ -33,7 +33,7 @@ use crate::scene::{LightId, TriId};
 pub const CHUNKED_MIN: usize = 4 * CHUNK;
 
 /// Triangles per chunk when a shadow ray walks a long list: it tests a box around each chunk (and
-/// around each group of `CHUNK` chunks) first ([`crate::visibility::lie`]).
+/// around each group of `CHUNK` chunks) first (the P-LIE modes, `visibility::lie`).
 pub const CHUNK: usize = 8;
 
 /// `record_index` entry for "no data object".

@@ -4,7 +4,7 @@
 //! obvhs' node test is a float slab test with two shortcuts that could lose a blocker: node intervals
 //! start at a fixed `t = 1e-4`, and direction components below `f32::EPSILON` get a clamped inverse.
 //! To stay exact we (1) build in a normalised space where the scene spans 1000 units, (2) pad every
-//! triangle box by [`PAD`] there, and (3) scale shadow rays so the segment runs over `t` in
+//! triangle box by `PAD` there, and (3) scale shadow rays so the segment runs over `t` in
 //! `[0, SEGMENT_T]`. Then the first `t` a blocker can have (`SEGMENT_EPS * SEGMENT_T = 1`) is far past
 //! `1e-4`, and a clamped inverse still keeps every point at least `PAD` inside a padded box within
 //! `PAD / EPSILON > SEGMENT_T` of the interval; rounding in the slab test is far below `PAD`. Candidates
@@ -13,12 +13,12 @@
 //! obvhs' traversal keeps the groups still to visit on a fixed 32-entry stack that, when full,
 //! overwrites its top entry: a BVH deeper than 31 inner levels (hundreds of coincident triangles, whose
 //! identical boxes PLOC pairs into a chain) would silently skip nodes. [`Bvh::build`] measures the
-//! depth, and traversals of a deeper BVH use a growable stack instead ([`Walk`]); the common, shallow
+//! depth, and traversals of a deeper BVH use a growable stack instead (`Walk`); the common, shallow
 //! case keeps obvhs' fixed stack. Boxes with one centre (exact copies, instances with one transform,
 //! triangles nested around a point) also made PLOC's build quadratic (5,000 copies of a triangle:
 //! 1.5 s and a depth of 713; 20,000 glTF instances: 70 s): PLOC orders boxes by the Morton code of
 //! their centres and cannot order equal codes. So more than [`CROWD_LIMIT`] boxes whose centres share
-//! a Morton cell become one primitive listing their triangles ([`Groups`]); ordinary scenes have no
+//! a Morton cell become one primitive listing their triangles (`Groups`); ordinary scenes have no
 //! such crowd and keep one primitive per triangle.
 
 use glam::{UVec2, Vec3, Vec3A};
@@ -45,7 +45,7 @@ const SEGMENT_T: f32 = 1e4;
 /// full stack overwrites the top entry, so it holds `FIXED_STACK - 1` entries without loss.
 const FIXED_STACK: usize = 32;
 
-/// More boxes than this with their centres in one Morton cell ([`group_crowded_centres`]) are one
+/// More boxes than this with their centres in one Morton cell (`group_crowded_centres`) are one
 /// BVH primitive. Two is common (both halves of an axis-aligned rectangle share their box), more rare.
 pub const CROWD_LIMIT: usize = 8;
 

@@ -133,11 +133,6 @@ impl LeafVoxels {
         }
         false
     }
-
-    /// Bytes held.
-    pub fn memory_bytes(&self) -> usize {
-        self.first.len() * 4 + self.voxels.len() * 8 + self.tris.len() * 4
-    }
 }
 
 #[cfg(test)]

@@ -8,14 +8,14 @@ pub mod brute;
 pub mod bvh;
 #[cfg(feature = "embree")]
 pub mod embree;
-pub mod fan;
-pub mod footprint;
-pub mod leaf_voxels;
-pub mod lie;
-pub mod list_boxes;
+pub(crate) mod fan;
+pub(crate) mod footprint;
+pub(crate) mod leaf_voxels;
+pub(crate) mod lie;
+pub(crate) mod list_boxes;
 pub mod mode;
 pub mod octree;
-pub mod pyramid;
+pub(crate) mod pyramid;
 pub mod query;
 pub mod shadows;
 
@@ -24,7 +24,7 @@ pub use brute::Brute;
 pub use bvh::BvhVisibility;
 #[cfg(feature = "embree")]
 pub use embree::{exact::ExactEmbreeVisibility, native::NativeEmbree};
-pub use lie::LieVisibility;
+pub(crate) use lie::LieVisibility;
 pub use mode::Mode;
 pub use octree::OctreeVisibility;
 pub use query::{blocks, LightAnswers, LightRays, QueryCtx, QueryStats, ShadowRay};

@@ -11,7 +11,7 @@
 use std::path::Path;
 use std::sync::OnceLock;
 
-use plie::io::plie_file::checksum;
+use plie::internals::io::plie_file::checksum;
 use plie::io::{load_scene_with, LoadOptions};
 use plie::octree::{Octree, OctreeParams};
 use plie::visibility::bvh::Bvh;
@@ -132,7 +132,7 @@ pub fn plie_file(bytes: &[u8], fix_checksum: bool) {
     let (scene, _) = plie_seed();
     with_files("f.plie", &bytes, &[], |dir| {
         if let Ok(env) = Environment::load(&dir.join("f.plie"), scene, None) {
-            let _ = plie::verify::verify_sample(scene, env.octree(), env.plie(), 8, 4, 1);
+            let _ = plie::internals::verify::verify_sample(scene, env.octree(), env.plie(), 8, 4, 1);
         }
     });
 }
@@ -167,7 +167,10 @@ pub fn plie_seed() -> &'static (Scene, Vec<u8>) {
     static SEED: OnceLock<(Scene, Vec<u8>)> = OnceLock::new();
     SEED.get_or_init(|| {
         let scene = plie::scene::builtin::load("cornell-cube-1").expect("built-in scene");
-        let params = plie::lie::PlieParams { grids: plie::lie::Grids::Build, ..plie::lie::PlieParams::thesis() };
+        let params = plie::internals::lie::PlieParams {
+            grids: plie::internals::lie::Grids::Build,
+            ..plie::internals::lie::PlieParams::thesis()
+        };
         let (env, _) = Environment::build(&scene, &params).expect("valid parameters");
         let dir = tempfile::tempdir().expect("a temporary folder");
         let path = dir.path().join("seed.plie");

@@ -96,12 +96,12 @@ pub struct Built {
 
 impl Built {
     /// Built with `params` plus face grids, refining the octree if `params.refine` asks.
-    pub fn refined(scene: &Scene, params: plie::lie::PlieParams) -> Built {
+    pub fn refined(scene: &Scene, params: plie::internals::lie::PlieParams) -> Built {
         Built::new(scene, params)
     }
 
-    pub fn new(scene: &Scene, params: plie::lie::PlieParams) -> Built {
-        let params = plie::lie::PlieParams { grids: plie::lie::Grids::Build, ..params };
+    pub fn new(scene: &Scene, params: plie::internals::lie::PlieParams) -> Built {
+        let params = plie::internals::lie::PlieParams { grids: plie::internals::lie::Grids::Build, ..params };
         let bvh = plie::visibility::bvh::Bvh::build(scene);
         let (env, _) = plie::Environment::build(scene, &params).expect("valid parameters");
         Built { bvh, env }
@@ -113,7 +113,7 @@ impl Built {
     }
 
     /// The P-LIE.
-    pub fn plie(&self) -> &plie::lie::Plie {
+    pub fn plie(&self) -> &plie::internals::lie::Plie {
         self.env.plie()
     }
 
@@ -128,8 +128,12 @@ impl Built {
 
 /// The construction (stages 1-7) on a given octree, without limits: what the tests that compare
 /// builds on one octree need (users call [`plie::Environment::build`]).
-pub fn construct(scene: &Scene, octree: &Octree, params: plie::lie::PlieParams) -> plie::construct::Built {
-    plie::construct::build_bounded(scene, octree.clone(), params, Default::default(), &plie::NoProgress)
+pub fn construct(
+    scene: &Scene,
+    octree: &Octree,
+    params: plie::internals::lie::PlieParams,
+) -> plie::internals::construct::Built {
+    plie::internals::construct::build_bounded(scene, octree.clone(), params, Default::default(), &plie::NoProgress)
         .expect("not cancelled")
 }
 

@@ -109,7 +109,7 @@ impl FaceStates {
 
 /// How much the watertight test's `t` of a blocking hit must clear `SEGMENT_EPS` by, relatively: far
 /// above the `f32` error of `t`.
-const BUDGET_SLACK: f64 = 1.001;
+pub const BUDGET_SLACK: f64 = 1.001;
 
 /// The budget of a face computed fully dark: the longest shadow ray `x -> y` that the umbra proves
 /// blocked when the ray leaves the cell grown by `delta` through this face, or 0 if it proves none.

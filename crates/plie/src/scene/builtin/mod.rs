@@ -52,7 +52,7 @@ pub fn description(name: &str) -> Option<&'static str> {
 }
 
 /// The built-in stress scenes (issue 15): many thin rods between the floor and a small light.
-/// `balusters-N` (N from 1 to [`balusters::MAX_RODS`] rods per side) is the same scene at another size.
+/// `balusters-N` (N from 1 to 256 rods per side) is the same scene at another size.
 pub const STRESS: [&str; 1] = ["balusters"];
 
 /// Whether `name` is a built-in scene (a thesis scene, a stress scene, or a sized stress scene).
