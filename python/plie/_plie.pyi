@@ -80,7 +80,7 @@ class Environment:
     def scene(self) -> Scene: ...
     @property
     def stats(self) -> Optional[Dict[str, Any]]:
-        """Construction figures when built here; None when loaded."""
+        """Construction figures when built here (the names of `plie build --json`); None when loaded."""
     @property
     def seconds(self) -> float: ...
     @property

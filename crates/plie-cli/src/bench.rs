@@ -189,19 +189,19 @@ fn build_plie(
     let mut last = None;
     for _ in 0..runs.max(1) {
         let (env, stats) = Environment::build(scene, &params)?;
-        times.push(stats.blockers_seconds);
+        times.push(stats.blockers.blockers_seconds);
         last = Some((env, stats));
     }
     let (env, s) = last.expect("at least one run");
     let r = BuildResult {
         config,
         seconds: median(&mut times),
-        leaves: s.leaves,
-        records: s.records,
-        records_removed_umbra: s.records_removed_umbra,
-        records_removed_propagation: s.records_removed_propagation,
-        blockers_mean: s.blockers_mean,
-        blockers_max: s.blockers_max,
+        leaves: s.octree.leaves,
+        records: s.blockers.records,
+        records_removed_umbra: s.regions.records_removed_umbra,
+        records_removed_propagation: s.propagation.records_removed,
+        blockers_mean: s.blockers.blockers_mean,
+        blockers_max: s.blockers.blockers_max,
     };
     Ok((env, r))
 }

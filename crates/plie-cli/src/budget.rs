@@ -66,10 +66,10 @@ pub fn check(budget: u64, scene: &Scene) -> Result<()> {
 
 /// Says (unless quiet) how many records the budget turned into scene records.
 pub fn warn_over(stats: &BuildStats, bar: &Bar) {
-    if stats.records_over_budget > 0 {
+    if stats.bounded.records_over_budget > 0 {
         bar.warn(&format!(
             "memory budget reached: {} records store no blocker list and are answered by the scene BVH (exact, slower to shade); raise --memory-budget to keep them",
-            stats.records_over_budget
+            stats.bounded.records_over_budget
         ));
     }
 }

@@ -261,5 +261,5 @@ pub fn build(scene: &Scene, params: PlieParams, bar: &Bar) -> Result<Loaded> {
     let list_bytes = Some(crate::budget::list_bytes(crate::budget::default_bytes(), scene));
     let (env, stats) = Environment::build_with(scene, &params, BuildOptions { list_bytes, progress: bar })?;
     crate::budget::warn_over(&stats, bar);
-    Ok(Loaded { env, build_seconds: Some(stats.blockers_seconds), load_seconds: None })
+    Ok(Loaded { env, build_seconds: Some(stats.blockers.blockers_seconds), load_seconds: None })
 }

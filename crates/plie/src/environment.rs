@@ -90,7 +90,8 @@ impl Environment {
         let built = crate::construct::build_bounded(scene, octree, *params, limits, options.progress)
             .map_err(|_| Error::Interrupted)?;
         let mut stats = built.stats;
-        stats.octree_seconds = octree_seconds;
+        stats.octree.octree_seconds = octree_seconds;
+        stats.bounded.list_budget = options.list_bytes;
         Ok((Environment::from_parts(scene, built.octree, built.plie), stats))
     }
 

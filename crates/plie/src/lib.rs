@@ -27,7 +27,8 @@
 //!
 //! // Build the P-LIE once (independent of any camera), save it, load it back.
 //! let (env, stats) = Environment::build(&scene, &PlieParams::default())?;
-//! assert!(stats.records > 0);
+//! assert!(stats.blockers.records > 0);
+//! println!("{stats}"); // a line or two per phase; `serde_json::to_string(&stats)` for JSON
 //! let path = std::env::temp_dir().join(format!("plie-doc-{}.plie", std::process::id()));
 //! env.save(&path, &scene)?;
 //! let env = Environment::load(&path, &scene, Some(env.params()))?;
@@ -69,7 +70,10 @@ pub(crate) mod lie;
 pub(crate) mod render;
 pub(crate) mod verify;
 
-pub use construct::{BuildStats, RoundStats};
+pub use construct::{
+    BlockerStats, BoundedStats, BuildStats, GridStats, OctreeStats, PropagationStats, RefinementStats, RegionStats,
+    RoundStats,
+};
 pub use environment::{BuildOptions, Environment, Report};
 pub use error::{Error, PlieFileError, Result};
 pub use lie::{Criterion, Grids, MaxBlockers, PlieParams, Propagation, RefineParams, Regions, DEFAULT_BLOCKER_CAP};

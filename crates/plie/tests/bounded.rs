@@ -72,8 +72,8 @@ fn capped_records_are_answered_by_the_scene_exactly() {
     let p = &built.plie;
     let scene_records = p.scene_records();
     assert!(scene_records > 20 && scene_records < p.records.len(), "{scene_records} of {}", p.records.len());
-    assert_eq!(built.stats.records_scene, scene_records);
-    assert_eq!(built.stats.records_over_budget, 0);
+    assert_eq!(built.stats.bounded.records_scene, scene_records);
+    assert_eq!(built.stats.bounded.records_over_budget, 0);
     for r in &p.records {
         assert!(r.blockers_len <= cap, "{r:?}");
         if r.kind == RecordKind::Scene {
@@ -95,21 +95,25 @@ fn the_cap_bounds_storage_and_the_gather() {
     let free = build(&scene, PlieParams { blocker_cap: None, ..PlieParams::default() }, Limits::default());
     let capped = build(&scene, PlieParams { blocker_cap: Some(cap), ..PlieParams::default() }, Limits::default());
     assert_eq!(free.plie.scene_records(), 0);
-    assert!(free.stats.blockers_max > 4 * cap, "the scene is not a stress test: {}", free.stats.blockers_max);
+    assert!(
+        free.stats.blockers.blockers_max > 4 * cap,
+        "the scene is not a stress test: {}",
+        free.stats.blockers.blockers_max
+    );
     let records = capped.plie.records.len();
     assert!(capped.plie.blockers.len() <= records * cap as usize);
     // Grid cells hold subsets of their record's list, at most SPLIT_GROWTH^3 < 16 times it.
     assert!(capped.plie.cell_blockers.len() <= 16 * records * cap as usize);
     assert!(
-        capped.stats.list_bytes < free.stats.list_bytes / 2,
+        capped.stats.bounded.list_bytes < free.stats.bounded.list_bytes / 2,
         "{} vs {}",
-        capped.stats.list_bytes,
-        free.stats.list_bytes
+        capped.stats.bounded.list_bytes,
+        free.stats.bounded.list_bytes
     );
     // The gather stops early: at most (cap + 1) * 16 candidates per computed record.
-    let computed = capped.stats.records + capped.stats.records_removed_umbra;
-    assert!(capped.stats.candidates_clipped <= computed * (cap as usize + 1) * 16);
-    assert!(capped.stats.candidates_clipped < free.stats.candidates_clipped);
+    let computed = capped.stats.blockers.records + capped.stats.regions.records_removed_umbra;
+    assert!(capped.stats.blockers.candidates_clipped <= computed * (cap as usize + 1) * 16);
+    assert!(capped.stats.blockers.candidates_clipped < free.stats.blockers.candidates_clipped);
     // Stress target of issue 15 as a count: the P-LIE's arrays within 2 KB per triangle.
     assert!(capped.plie.memory_bytes() <= 2048 * scene.triangle_count(), "{}", capped.plie.memory_bytes());
 }
@@ -119,12 +123,12 @@ fn the_memory_budget_degrades_records_in_task_order_and_stays_exact() {
     let scene = balusters();
     let params = PlieParams { blocker_cap: Some(256), ..PlieParams::default() };
     let free = build(&scene, params, Limits::default());
-    let budget = free.stats.list_bytes / 3;
+    let budget = free.stats.bounded.list_bytes / 3;
     let limits = Limits { list_bytes: Some(budget) };
     let tight = build(&scene, params, limits);
-    assert!(tight.stats.records_over_budget > 0);
-    assert!(tight.stats.list_bytes <= budget, "{} > {budget}", tight.stats.list_bytes);
-    assert_eq!(tight.stats.records_scene, tight.plie.scene_records());
+    assert!(tight.stats.bounded.records_over_budget > 0);
+    assert!(tight.stats.bounded.list_bytes <= budget, "{} > {budget}", tight.stats.bounded.list_bytes);
+    assert_eq!(tight.stats.bounded.records_scene, tight.plie.scene_records());
     assert_eq!(tight.plie.records.len(), free.plie.records.len());
     // Decided at the commits, in task order: the same P-LIE on one thread.
     let one = rayon::ThreadPoolBuilder::new().num_threads(1).build().unwrap();

@@ -79,7 +79,7 @@ fn blockers_contain_every_triangle_between_face_and_light() {
     let params = PlieParams { max_triangles: 8, ..PlieParams::thesis() };
     let octree = Octree::build(&scene, params.octree()).expect("valid octree parameters");
     let (plie, stats) = build_on(&scene, &octree, params);
-    assert!(stats.records > 0 && stats.blockers_total > 0);
+    assert!(stats.blockers.records > 0 && stats.blockers.blockers_total > 0);
     let mut rng = Rng(3);
     let mut checked = 0;
     for r in &plie.records {
@@ -172,7 +172,7 @@ fn lie_mode_matches_brute_force_in_the_room() {
         let params = PlieParams { max_triangles, ..PlieParams::default() };
         let octree = Octree::build(&scene, params.octree()).expect("valid octree parameters");
         let (plie, stats) = build_on(&scene, &octree, params);
-        assert!(stats.grids > 0);
+        assert!(stats.grids.grids > 0);
         let brute = Brute::new(&scene);
         let env = plie::Environment::from_parts(&scene, octree.clone(), plie.clone());
         let modes = PLIE_MODES.map(|m| (m, env.visibility(m, &scene).unwrap()));
@@ -281,8 +281,8 @@ fn construction_does_not_depend_on_the_thread_count() {
         let (one, s1) = build(1);
         let (two, s2) = build(2);
         assert!(one == two, "{name}: P-LIE differs between 1 and 2 threads");
-        assert_eq!(s1.records, s2.records);
-        assert!(s1.blockers_total > 0);
+        assert_eq!(s1.blockers.records, s2.blockers.records);
+        assert!(s1.blockers.blockers_total > 0);
     }
 }
 
@@ -293,7 +293,7 @@ fn grid_cells_contain_every_triangle_between_cell_and_light() {
     let params = PlieParams { max_triangles: 64, ..PlieParams::default() };
     let octree = Octree::build(&scene, params.octree()).expect("valid octree parameters");
     let (plie, stats) = build_on(&scene, &octree, params);
-    assert!(stats.grids > 0, "{stats:?}");
+    assert!(stats.grids.grids > 0, "{stats:?}");
     let mut rng = Rng(23);
     let mut checked = 0;
     for (r, g) in plie.records.iter().zip(&plie.grids) {

@@ -23,10 +23,10 @@ fn build_includes_refinement_and_equals_the_stages() {
     let octree = Octree::build(&scene, params.octree()).unwrap();
     let built =
         plie::internals::construct::build_bounded(&scene, octree, params, Default::default(), &NoProgress).unwrap();
-    assert!(stats.refine_rounds > 0, "cornell-cube-4 refines by umbra");
+    assert!(stats.refinement.rounds > 0, "cornell-cube-4 refines by umbra");
     assert_eq!(env.plie(), &built.plie);
     assert_eq!(env.octree(), &built.octree);
-    assert_eq!(stats.records, built.stats.records);
+    assert_eq!(stats.blockers.records, built.stats.blockers.records);
     assert!(env.validate(&scene).is_ok(), "{}", env.validate(&scene));
 }
 

@@ -29,9 +29,9 @@ fn statuses_and_summary_agree_with_the_builder() {
         let (octree, plie, stats) = build(&scene, PlieParams::default());
         let ins = Inspector::new(&scene, &octree, &plie).unwrap();
         let s = ins.summary(Filter::default());
-        assert_eq!(s.records, stats.records, "{}", scene.name);
-        assert_eq!(s.removed, stats.records_removed_umbra, "{}", scene.name);
-        assert_eq!(s.cannot_see_light, stats.no_record_face_cannot_see_light, "{}", scene.name);
+        assert_eq!(s.records, stats.blockers.records, "{}", scene.name);
+        assert_eq!(s.removed, stats.regions.records_removed_umbra, "{}", scene.name);
+        assert_eq!(s.cannot_see_light, stats.blockers.records_removed_face_cannot_see_light, "{}", scene.name);
         // Fractions summed from the stored triangles match the builder's polygon areas.
         let rows: Vec<_> = s.leaves.iter().flat_map(|l| &l.faces).filter(|f| f.blockers.is_some()).collect();
         let mean = |get: fn(&plie::internals::inspect::summary::FaceSummary) -> f64| {
@@ -40,12 +40,12 @@ fn statuses_and_summary_agree_with_the_builder() {
         let umbra = mean(|f| f.umbra_fraction.unwrap());
         let penumbra = mean(|f| f.penumbra_fraction.unwrap());
         assert!(
-            (umbra - stats.umbra_fraction_mean).abs() < 1e-3,
+            (umbra - stats.regions.umbra_fraction_mean).abs() < 1e-3,
             "{}: {umbra} vs {}",
             scene.name,
-            stats.umbra_fraction_mean
+            stats.regions.umbra_fraction_mean
         );
-        assert!((penumbra - stats.penumbra_fraction_mean).abs() < 1e-3, "{}: {penumbra}", scene.name);
+        assert!((penumbra - stats.regions.penumbra_fraction_mean).abs() < 1e-3, "{}: {penumbra}", scene.name);
     }
 }
 

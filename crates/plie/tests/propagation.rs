@@ -113,7 +113,7 @@ fn check_scene(scene: &Scene, max_triangles: usize, samples: usize) -> (usize, u
     let with = build(scene, &octree, params);
     let without = build(scene, &octree, PlieParams { propagation: Propagation::Off, ..params });
     assert!(without.propagated.is_empty());
-    assert_eq!(with.stats.records_removed_propagation, with.propagated.len());
+    assert_eq!(with.stats.propagation.records_removed, with.propagated.len());
     check_same_records(scene, &octree, &with, &without.plie);
     (with.propagated.len(), check_sound(scene, &octree, &with, samples))
 }
@@ -173,8 +173,8 @@ fn propagated_records_of_refined_p_lies_are_dark() {
             &Octree::build(&scene, params.octree()).expect("valid octree parameters"),
             params,
         );
-        assert!(b.stats.refine_rounds > 0);
-        assert_eq!(b.stats.records_removed_propagation, b.propagated.len());
+        assert!(b.stats.refinement.rounds > 0);
+        assert_eq!(b.stats.propagation.records_removed, b.propagated.len());
         let c = check_sound(&scene, &b.octree, &b, 16);
         eprintln!("{name} refined: {} records propagated, {c} segments blocked", b.propagated.len());
         propagated += b.propagated.len();

@@ -96,15 +96,15 @@ fn reused_records_equal_a_build_from_scratch() {
         let params = PlieParams { propagation: Propagation::Off, grids: Grids::Build, ..refined_params() };
         let octree = Octree::build(&scene, params.octree()).expect("valid octree parameters");
         let refined = support::construct(&scene, &octree, params);
-        assert!(refined.stats.refine_rounds > 0, "{name}: nothing split");
+        assert!(refined.stats.refinement.rounds > 0, "{name}: nothing split");
         let fresh = support::construct(&scene, &refined.octree, PlieParams { refine: RefineParams::none(), ..params });
         let (fresh, stats) = (fresh.plie, fresh.stats);
         let mut got = refined.plie.clone();
         got.splits.clear();
         got.params.refine = RefineParams::none();
         assert!(got == fresh, "{name}: the refined build's records differ from a fresh build on its octree");
-        assert_eq!(refined.stats.records, stats.records);
-        assert_eq!(refined.stats.records_removed_umbra, stats.records_removed_umbra);
+        assert_eq!(refined.stats.blockers.records, stats.blockers.records);
+        assert_eq!(refined.stats.regions.records_removed_umbra, stats.regions.records_removed_umbra);
     }
 }
 
@@ -139,21 +139,21 @@ fn max_split_depth_bounds_a_chain_that_would_never_stop() {
         let refine = RefineParams { blockers: Some(MaxBlockers::Fixed(0)), max_split_depth: k, ..RefineParams::none() };
         let params = PlieParams { refine, ..PlieParams::thesis() };
         let b = support::construct(&scene, &base, params);
-        assert_eq!(b.stats.refine_rounds, k as usize, "k = {k}");
+        assert_eq!(b.stats.refinement.rounds, k as usize, "k = {k}");
         assert_eq!(b.plie.splits.len(), k as usize);
         assert_eq!(b.octree.depth(), 1 + k, "k = {k}: some leaf splits exactly k times");
         assert!(b.octree.leaves().all(|l| b.octree.leaf_depth(l) <= 1 + k));
         assert!(b.octree.validate(&scene).violations.is_empty());
-        let splits: usize = b.stats.refine_splits.values().sum();
+        let splits: usize = b.stats.refinement.splits_by_criterion.values().sum();
         assert_eq!(b.octree.leaf_count(), base.leaf_count() + 7 * splits);
         assert_eq!(
-            b.stats.refine_splits.keys().copied().collect::<Vec<_>>(),
+            b.stats.refinement.splits_by_criterion.keys().copied().collect::<Vec<_>>(),
             if k == 0 { vec![] } else { vec!["blockers"] }
         );
         if k > 0 {
-            let u = b.stats.unrefined.expect("the unrefined round's figures");
+            let u = b.stats.refinement.unrefined.expect("the unrefined round's figures");
             assert_eq!(u.leaves, base.leaf_count());
-            assert!(b.stats.records > u.records);
+            assert!(b.stats.blockers.records > u.records);
         }
     }
 }
@@ -166,7 +166,11 @@ fn umbra_refinement_removes_more_dark_records() {
     let octree = Octree::build(&scene, PlieParams::thesis().octree()).expect("valid octree parameters");
     let plain = support::construct(&scene, &octree, PlieParams::thesis()).stats;
     let b = support::construct(&scene, &octree, refined_params());
-    assert!(b.stats.refine_splits.get("umbra_full").copied().unwrap_or(0) > 0, "{:?}", b.stats.refine_splits);
-    let dark = |s: &plie::internals::construct::BuildStats| s.records_removed_umbra + s.records_removed_propagation;
+    assert!(
+        b.stats.refinement.splits_by_criterion.get("umbra_full").copied().unwrap_or(0) > 0,
+        "{:?}",
+        b.stats.refinement.splits_by_criterion
+    );
+    let dark = |s: &plie::BuildStats| s.regions.records_removed_umbra + s.propagation.records_removed;
     assert!(dark(&b.stats) > dark(&plain), "refined {} dark records, unrefined {}", dark(&b.stats), dark(&plain));
 }

@@ -42,31 +42,39 @@ pub(super) fn finish(
 ) -> Built {
     let Round { tasks, propagator_log: propagated, states, over_budget, .. } = round;
     let lights = scene.lights.len();
-    let mut stats = BuildStats {
-        leaves: octree.leaf_count(),
-        faces_considered: octree.leaf_count() * 6 * lights,
-        propagation_wasted: totals.wasted,
-        propagation_seconds: totals.seconds,
-        refine_rounds: refiner.splits.len(),
-        refine_splits: refiner.by_criterion,
-        unrefined: totals.unrefined,
-        ..Default::default()
-    };
-    stats.records_over_budget = over_budget;
+    let mut stats = BuildStats::default();
+    stats.octree.leaves = octree.leaf_count();
+    stats.octree.depth = octree.depth();
+    stats.blockers.faces_considered = octree.leaf_count() * 6 * lights;
+    stats.bounded.blocker_cap = params.blocker_cap;
+    stats.bounded.records_over_budget = over_budget;
+    stats.regions.regions = params.has_regions();
+    let p = &mut stats.propagation;
+    p.enabled = params.propagation == crate::lie::Propagation::On;
+    (p.wasted, p.seconds, p.tests) = (totals.wasted, totals.seconds, totals.tests);
+    let r = &mut stats.refinement;
+    r.criteria = params.refine.chain().iter().map(|c| c.name()).collect();
+    r.max_split_depth = params.refine.max_split_depth;
+    r.max_blockers = params.refine.blockers.map(|m| format!("{m:?}"));
+    r.rounds = refiner.splits.len();
+    r.leaves_added = 7 * refiner.by_criterion.values().sum::<usize>();
+    r.splits_by_criterion = refiner.by_criterion;
+    r.unrefined = totals.unrefined;
+    stats.grids.enabled = params.has_grids();
     let mut plie = flatten(&octree, params, lights, tasks, &mut stats);
     plie.splits = refiner.splits;
-    stats.propagation_tests = totals.tests;
-    stats.records_removed_propagation = propagated.len();
+    stats.propagation.records_removed = propagated.len();
     debug_assert_eq!(propagated.len(), states.propagated());
     for p in &propagated {
-        *stats.propagation_by_rule.entry(p.rule.name()).or_default() += 1;
+        *stats.propagation.by_rule.entry(p.rule.name()).or_default() += 1;
     }
-    stats.no_record_face_cannot_see_light =
-        stats.faces_considered - stats.records - stats.records_removed_umbra - stats.records_removed_propagation;
+    let b = &mut stats.blockers;
+    b.records_removed_face_cannot_see_light =
+        b.faces_considered - b.records - stats.regions.records_removed_umbra - stats.propagation.records_removed;
     let threads = rayon::current_num_threads().max(1) as f64;
-    stats.propagation_seconds_saved_estimate =
-        stats.records_removed_propagation as f64 * stats.record_seconds_mean / threads - totals.seconds;
-    stats.blockers_seconds = t0.elapsed().as_secs_f64();
+    let p = &mut stats.propagation;
+    p.seconds_saved_estimate = p.records_removed as f64 * p.record_seconds_mean / threads - totals.seconds;
+    stats.blockers.blockers_seconds = t0.elapsed().as_secs_f64();
     Built { octree, plie, stats, propagated }
 }
 
@@ -94,12 +102,12 @@ pub(super) fn flatten(
     };
     let (mut task_seconds, mut computed) = (0.0, 0);
     for t in &tasks {
-        stats.candidates_clipped += t.candidates;
-        stats.records_removed_umbra += t.removed_umbra;
+        stats.blockers.candidates_clipped += t.candidates;
+        stats.regions.records_removed_umbra += t.removed_umbra;
         task_seconds += t.seconds;
         computed += t.computed.iter().flatten().count();
     }
-    stats.record_seconds_mean = if computed > 0 { task_seconds / computed as f64 } else { 0.0 };
+    stats.propagation.record_seconds_mean = if computed > 0 { task_seconds / computed as f64 } else { 0.0 };
     let (mut umbra_sum, mut penumbra_sum) = (0.0, 0.0);
     for leaf in octree.leaves() {
         for face in Dir::ALL {
@@ -109,9 +117,9 @@ pub(super) fn flatten(
                 plie.grids.push(fg);
                 let mut rr = RecordRegions::default();
                 if let Some(reg) = rec.regions {
-                    stats.records_with_umbra += !reg.umbra.is_empty() as usize;
-                    stats.records_with_penumbra += !reg.penumbra.is_empty() as usize;
-                    stats.region_polygon_vertices += reg.polygon_vertices;
+                    stats.regions.records_with_umbra += !reg.umbra.is_empty() as usize;
+                    stats.regions.records_with_penumbra += !reg.penumbra.is_empty() as usize;
+                    stats.regions.region_polygon_vertices += reg.polygon_vertices;
                     umbra_sum += reg.umbra_fraction;
                     penumbra_sum += reg.penumbra_fraction;
                     rr.umbra_start = plie.region_tris.len() as u32;
@@ -133,22 +141,25 @@ pub(super) fn flatten(
                     blockers_len: rec.blockers.len() as u32,
                     kind: rec.kind,
                 });
-                stats.records_scene += (rec.kind == RecordKind::Scene) as usize;
+                stats.bounded.records_scene += (rec.kind == RecordKind::Scene) as usize;
                 plie.blockers.extend(rec.blockers);
             }
         }
     }
-    stats.records = plie.records.len();
-    stats.region_triangles = plie.region_tris.len();
-    stats.region_bytes = plie.region_tris.len() * std::mem::size_of::<crate::lie::Tri2>()
+    let records = plie.records.len();
+    stats.blockers.records = records;
+    let r = &mut stats.regions;
+    r.region_triangles = plie.region_tris.len();
+    r.region_bytes = plie.region_tris.len() * std::mem::size_of::<crate::lie::Tri2>()
         + plie.regions.len() * std::mem::size_of::<RecordRegions>();
-    if params.has_regions() && stats.records > 0 {
-        stats.umbra_fraction_mean = umbra_sum / stats.records as f64;
-        stats.penumbra_fraction_mean = penumbra_sum / stats.records as f64;
+    if params.has_regions() && records > 0 {
+        r.umbra_fraction_mean = umbra_sum / records as f64;
+        r.penumbra_fraction_mean = penumbra_sum / records as f64;
     }
-    stats.blockers_total = plie.blockers.len();
-    stats.list_bytes = (plie.blockers.len() + plie.cell_blockers.len()) * std::mem::size_of::<TriId>();
-    (stats.blockers_mean, stats.blockers_max) = plie.blocker_stats();
+    stats.blockers.blockers_total = plie.blockers.len();
+    stats.bounded.list_bytes = (plie.blockers.len() + plie.cell_blockers.len()) * std::mem::size_of::<TriId>();
+    stats.grids.grid_blockers_total = plie.cell_blockers.len();
+    (stats.blockers.blockers_mean, stats.blockers.blockers_max) = plie.blocker_stats();
     plie
 }
 
@@ -158,7 +169,7 @@ pub(super) fn flatten_grid(grid: Option<grid::PendingGrid>, plie: &mut Plie, sta
         return FaceGrid::default();
     };
     let fg = FaceGrid { res: pg.g, cells_start: plie.cells.len() as u32 };
-    stats.grids += 1;
+    stats.grids.grids += 1;
     let mut ranges = Vec::with_capacity(pg.lists.len());
     for l in pg.lists {
         ranges.push((plie.cell_blockers.len() as u32, l.len() as u32));
@@ -166,15 +177,15 @@ pub(super) fn flatten_grid(grid: Option<grid::PendingGrid>, plie: &mut Plie, sta
     }
     let cells = (pg.g * pg.g) as usize;
     for i in 0..cells {
-        stats.grid_cells += 1;
+        stats.grids.grid_cells += 1;
         if pg.umbra.get(i).copied().unwrap_or(false) {
-            stats.grid_cells_umbra += 1;
+            stats.grids.grid_cells_umbra += 1;
             plie.cells.push(UMBRA_CELL);
         } else if pg.scene {
             plie.cells.push(SCENE_CELL);
         } else {
             let r = ranges[pg.cell_list[i] as usize];
-            stats.grid_cells_lit += (r.1 == 0) as usize;
+            stats.grids.grid_cells_lit += (r.1 == 0) as usize;
             plie.cells.push(r);
         }
     }

@@ -41,7 +41,10 @@ use crate::scene::Scene;
 use propagation::Propagated;
 use refine::Refiner;
 use round::{run_round, Prior};
-pub use stats::{BuildStats, RoundStats};
+pub use stats::{
+    BlockerStats, BoundedStats, BuildStats, GridStats, OctreeStats, PropagationStats, RefinementStats, RegionStats,
+    RoundStats,
+};
 
 pub use crate::geometry::TOLERANCE_REL;
 
