@@ -41,9 +41,8 @@ pub struct Args {
     /// Runs per measurement; the median is reported (default 5, 1 with --quick and with --path).
     #[arg(long, value_name = "N")]
     runs: Option<usize>,
-    /// Worker threads for the all-threads figures (default: all cores).
-    #[arg(long, value_name = "T")]
-    threads: Option<usize>,
+    #[command(flatten)]
+    threads: crate::threads_arg::ThreadsArg,
     /// Directory of the thesis' figures (construction.tsv, shading-times.tsv).
     #[arg(long, default_value = "../shared/thesis", value_name = "DIR")]
     thesis: PathBuf,
@@ -88,7 +87,7 @@ fn plan(a: &Args) -> Result<Plan> {
 }
 
 pub fn run(a: &Args) -> Result<()> {
-    crate::scenes::set_threads(a.threads)?;
+    a.threads.install()?;
     std::fs::create_dir_all(&a.out).with_context(|| format!("cannot create directory {}", a.out.display()))?;
     if a.soft_shadows {
         let scenes = if a.scenes.is_empty() { crate::bench_soft::default_scenes(&a.shared) } else { a.scenes.clone() };

@@ -27,9 +27,8 @@ pub struct Args {
     /// (they are answered by the scene BVH, exactly) and says so; it never aborts.
     #[arg(long, value_name = "SIZE", value_parser = crate::budget::parse_bytes)]
     memory_budget: Option<u64>,
-    /// Worker threads (default: all cores). The result does not depend on it.
-    #[arg(long, value_name = "T")]
-    threads: Option<usize>,
+    #[command(flatten)]
+    threads: crate::threads_arg::ThreadsArg,
     /// Print one JSON object with the figures on stdout.
     #[arg(long)]
     json: bool,
@@ -41,7 +40,7 @@ pub struct Args {
 pub fn run(a: &Args) -> Result<()> {
     // First, so that Ctrl-C at any point before the file is written stops the build cleanly.
     crate::progress::install_interrupt()?;
-    crate::scenes::set_threads(a.threads)?;
+    a.threads.install()?;
     crate::checks::plie_output(&a.output, &a.scene.file().into_iter().collect::<Vec<_>>())?;
     let scene = a.scene.load()?;
     if !a.quiet {

@@ -58,9 +58,8 @@ pub struct Args {
     /// PNG: width of the leaf edges in pixels (the inspected leaf's are twice as wide).
     #[arg(long, default_value_t = 1.5, value_name = "PX")]
     line_width: f32,
-    /// Worker threads (default: all cores).
-    #[arg(long, value_name = "T")]
-    threads: Option<usize>,
+    #[command(flatten)]
+    threads: crate::threads_arg::ThreadsArg,
     #[command(flatten)]
     params: PlieArgs,
     /// Inspect this P-LIE file (from `plie build`) instead of building one; its build parameters come
@@ -91,7 +90,7 @@ fn output_kind(path: &Path) -> Result<Output> {
 }
 
 pub fn run(a: &Args, matches: &clap::ArgMatches) -> Result<()> {
-    crate::scenes::set_threads(a.threads)?;
+    a.threads.install()?;
     if a.output.is_none() && !a.summary {
         bail!("nothing to do: give -o OUT (.png, .gltf, .glb) with --cell X,Y,Z, or --summary");
     }

@@ -20,6 +20,7 @@ mod render;
 mod render_path;
 mod scene_arg;
 mod scenes;
+mod threads_arg;
 mod verify;
 mod walkthrough;
 

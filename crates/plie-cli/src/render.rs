@@ -57,9 +57,8 @@ pub struct Args {
     /// embree`. Default: `bvh`; with --plie, the fastest mode the file supports.
     #[arg(long, value_name = "MODE")]
     visibility: Option<Mode>,
-    /// Worker threads (default: all cores). Images do not depend on it.
-    #[arg(long, value_name = "T")]
-    threads: Option<usize>,
+    #[command(flatten)]
+    threads: crate::threads_arg::ThreadsArg,
     #[command(flatten)]
     params: PlieArgs,
     /// Use this P-LIE file (from `plie build`) instead of building one; only the P-LIE modes (`lie`,
@@ -79,7 +78,7 @@ pub struct Args {
 }
 
 pub fn run(a: &Args, matches: &clap::ArgMatches) -> Result<()> {
-    crate::scenes::set_threads(a.threads)?;
+    a.threads.install()?;
     plie::io::ImageFormat::from_path(&a.output)?;
     let inputs: Vec<&std::path::Path> =
         a.scene.file().into_iter().chain(a.plie.as_deref()).chain(a.camera_path.as_deref()).collect();

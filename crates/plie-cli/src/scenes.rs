@@ -42,8 +42,3 @@ pub fn count(n: usize, noun: &str) -> String {
         format!("{n} {noun}s")
     }
 }
-
-/// Sets the global rayon pool size (`--threads`), bounded ([`crate::checks::set_threads`]).
-pub fn set_threads(threads: Option<usize>) -> Result<()> {
-    crate::checks::set_threads(threads)
-}

@@ -28,13 +28,12 @@ pub struct Args {
     /// Seed of the sample.
     #[arg(long, default_value_t = 0)]
     seed: u64,
-    /// Worker threads for --full (default: all cores).
-    #[arg(long, value_name = "T")]
-    threads: Option<usize>,
+    #[command(flatten)]
+    threads: crate::threads_arg::ThreadsArg,
 }
 
 pub fn run(a: &Args) -> Result<()> {
-    crate::scenes::set_threads(a.threads)?;
+    a.threads.install()?;
     let t = Instant::now();
     let scene = a.scene.load()?;
     let env = plie::Environment::load(&a.file, &scene, None)
