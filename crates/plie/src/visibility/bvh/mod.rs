@@ -18,7 +18,7 @@
 //! triangles nested around a point) also made PLOC's build quadratic (5,000 copies of a triangle:
 //! 1.5 s and a depth of 713; 20,000 glTF instances: 70 s): PLOC orders boxes by the Morton code of
 //! their centres and cannot order equal codes. So more than [`CROWD_LIMIT`] boxes whose centres share
-//! a Morton cell become one primitive listing their triangles (`Groups`); ordinary scenes have no
+//! a Morton cell become one primitive listing their triangles (`crowd.rs`); ordinary scenes have no
 //! such crowd and keep one primitive per triangle.
 
 use glam::{UVec2, Vec3, Vec3A};
@@ -29,11 +29,14 @@ use obvhs::faststack::{FastStack, StackStack};
 use obvhs::ploc::PlocBuilder;
 use obvhs::ray::Ray;
 use obvhs::BvhBuildParams;
-use rayon::prelude::*;
 
 use super::{blocks, QueryCtx, ShadowRay, Visibility};
 use crate::geometry::RayTest;
 use crate::scene::{Scene, TriId};
+pub use crowd::CROWD_LIMIT;
+use crowd::{group_crowded_centres, Groups, Prims, Single};
+
+mod crowd;
 
 /// Size of the scene in the BVH's normalised space.
 const NORMALISED_SIZE: f32 = 1000.0;
@@ -45,10 +48,6 @@ const SEGMENT_T: f32 = 1e4;
 /// full stack overwrites the top entry, so it holds `FIXED_STACK - 1` entries without loss.
 const FIXED_STACK: usize = 32;
 
-/// More boxes than this with their centres in one Morton cell (`group_crowded_centres`) are one
-/// BVH primitive. Two is common (both halves of an axis-aligned rectangle share their box), more rare.
-pub const CROWD_LIMIT: usize = 8;
-
 /// A BVH over the scene's triangles.
 pub struct Bvh {
     cw: CwBvh,
@@ -59,36 +58,6 @@ pub struct Bvh {
     /// The triangles of each primitive when some centres were crowded ([`CROWD_LIMIT`]); else every
     /// primitive is the triangle of the same index.
     groups: Option<Groups>,
-}
-
-/// The triangles of each BVH primitive `p`: `tris[starts[p]..starts[p + 1]]`.
-struct Groups {
-    starts: Vec<u32>,
-    tris: Vec<u32>,
-}
-
-/// The triangles of a BVH primitive. Traversals are compiled for each kind, so the common one
-/// ([`Single`]) pays nothing for the other.
-trait Prims {
-    /// The triangles of primitive `*p` (`p` points into the BVH's primitive index array).
-    fn of<'a>(&'a self, p: &'a u32) -> &'a [u32];
-}
-
-/// Every primitive is the triangle of the same index.
-struct Single;
-
-impl Prims for Single {
-    #[inline(always)]
-    fn of<'a>(&'a self, p: &'a u32) -> &'a [u32] {
-        std::slice::from_ref(p)
-    }
-}
-
-impl Prims for Groups {
-    #[inline(always)]
-    fn of<'a>(&'a self, p: &'a u32) -> &'a [u32] {
-        &self.tris[self.starts[*p as usize] as usize..self.starts[*p as usize + 1] as usize]
-    }
 }
 
 /// Calls `$f($stack, $prims, args...)` with the traversal stack and primitive kind `$bvh` needs.
@@ -129,7 +98,7 @@ impl Bvh {
                 BAabb::new(lo, hi)
             })
             .collect();
-        let (cw, groups) = match group.then(|| group_crowded_centres(&boxes)).flatten() {
+        let (cw, groups) = match group.then(|| group_crowded_centres(&boxes, NORMALISED_SIZE, PAD)).flatten() {
             None => (build_cwbvh(&boxes, BvhBuildParams::medium_build()), None),
             Some((prim_boxes, groups)) => (build_cwbvh(&prim_boxes, BvhBuildParams::medium_build()), Some(groups)),
         };
@@ -155,7 +124,7 @@ impl Bvh {
 
     /// Bytes used by the nodes and index array.
     pub fn memory_bytes(&self) -> usize {
-        let groups = self.groups.as_ref().map_or(0, |g| (g.starts.len() + g.tris.len()) * 4);
+        let groups = self.groups.as_ref().map_or(0, Groups::memory_bytes);
         self.cw.nodes.len() * std::mem::size_of_val(&self.cw.nodes[0]) + self.cw.primitive_indices.len() * 4 + groups
     }
 
@@ -285,61 +254,6 @@ fn build_cwbvh(boxes: &[BAabb], config: BvhBuildParams) -> CwBvh {
     );
     ReinsertionOptimizer::default().run(&mut bvh2, config.reinsertion_batch_ratio, None);
     bvh2_to_cwbvh(&bvh2, config.max_prims_per_leaf.clamp(1, 3), true, false)
-}
-
-/// Cells per axis of the grid that [`group_crowded_centres`] puts box centres in: 2^21, the
-/// resolution of the 63-bit Morton codes PLOC sorts by (`SortPrecision::U64`).
-const CENTRE_CELLS: f64 = (1u32 << 21) as f64;
-
-/// When more than [`CROWD_LIMIT`] boxes have their centres in one cell of a 2^21-per-axis grid over
-/// the normalised scene (so one Morton code, which PLOC cannot order: exact copies, instances with
-/// one transform, or triangles nested around one centre): the primitives' boxes (one per crowded
-/// cell, the union of its boxes, and one per other triangle, in order of first appearance) and their
-/// triangles.
-fn group_crowded_centres(boxes: &[BAabb]) -> Option<(Vec<BAabb>, Groups)> {
-    let per_unit = CENTRE_CELLS / f64::from(NORMALISED_SIZE + 2.0 * PAD);
-    // The cell as one number: 21 bits per axis.
-    let cell = |b: &BAabb| {
-        let c = (b.min + b.max) * 0.5;
-        let [x, y, z] = c.to_array().map(|x| (f64::from(x + PAD) * per_unit).clamp(0.0, CENTRE_CELLS - 1.0) as u64);
-        x << 42 | y << 21 | z
-    };
-    // Whether any cell holds more than the limit: sorted, a crowd is a run (the common case ends here).
-    let mut sorted: Vec<u64> = boxes.par_iter().map(cell).collect();
-    sorted.par_sort_unstable();
-    if !sorted.windows(CROWD_LIMIT + 1).any(|w| w[0] == w[CROWD_LIMIT]) {
-        return None;
-    }
-    let mut count = std::collections::HashMap::new();
-    for run in sorted.chunk_by(|a, b| a == b) {
-        count.insert(run[0], run.len());
-    }
-    let cells: Vec<u64> = boxes.iter().map(cell).collect();
-    let mut crowd = std::collections::HashMap::new();
-    let mut members: Vec<Vec<u32>> = Vec::new();
-    let mut prim_boxes: Vec<BAabb> = Vec::new();
-    for (t, (b, c)) in boxes.iter().zip(&cells).enumerate() {
-        if count[c] > CROWD_LIMIT {
-            let p = *crowd.entry(*c).or_insert_with(|| {
-                prim_boxes.push(*b);
-                members.push(Vec::new());
-                members.len() - 1
-            });
-            prim_boxes[p] = prim_boxes[p].union(b);
-            members[p].push(t as u32);
-        } else {
-            prim_boxes.push(*b);
-            members.push(vec![t as u32]);
-        }
-    }
-    let mut starts = Vec::with_capacity(members.len() + 1);
-    let mut tris = Vec::with_capacity(boxes.len());
-    starts.push(0);
-    for m in members {
-        tris.extend(m);
-        starts.push(tris.len() as u32);
-    }
-    Some((prim_boxes, Groups { starts, tris }))
 }
 
 /// Depth of the deepest inner node of `cw` (the root is 0; 0 for an empty BVH). The inner children of
