@@ -22,7 +22,9 @@
 //! [`Scene::warnings`].
 
 pub mod props;
+mod sensor;
 pub mod shapes;
+mod warnings;
 pub mod xml;
 
 use std::collections::HashMap;
@@ -32,7 +34,7 @@ use std::rc::Rc;
 use glam::{Mat4, Vec2, Vec3};
 
 use self::props::{boolean, find, float, integer, string, transform};
-use self::xml::{parse_scene, Elem};
+use self::xml::{parse_scene, register_ids, Elem};
 use super::input::{resolve_in_scene, short, LoadOptions};
 use super::lights::{self, EmissiveTriangle};
 use super::scene_name;
@@ -40,7 +42,7 @@ use super::texture_file::load_texture;
 use super::tri_mesh::TriMesh;
 use crate::error::{Error, Result};
 use crate::scene::texture::{Filter, Texture, Wrap};
-use crate::scene::{Camera, Material, MaterialId, Scene, SceneBuilder, TextureId};
+use crate::scene::{Material, MaterialId, Scene, SceneBuilder, TextureId};
 
 /// The most triangles a Mitsuba scene may expand to (instances included).
 pub const MAX_TRIANGLES: usize = 50_000_000;
@@ -99,21 +101,6 @@ pub fn load_mitsuba_with(path: &Path, opts: LoadOptions) -> Result<Scene> {
         }
     }
     l.finish(&doc.root)
-}
-
-/// Records every element with an `id`; a repeated id is an error.
-fn register_ids<'a>(e: &'a Elem, ids: &mut HashMap<String, &'a Elem>) -> Result<()> {
-    for c in &e.children {
-        if c.tag != "ref" {
-            if let Some(id) = c.attr("id") {
-                if ids.insert(id.to_string(), c).is_some() {
-                    return Err(c.error(format!("the id '{}' is used twice", short(id))));
-                }
-            }
-        }
-        register_ids(c, ids)?;
-    }
-    Ok(())
 }
 
 /// A BSDF as plie renders it.
@@ -475,72 +462,17 @@ impl<'a> Loader<'a> {
         Ok((id, mean))
     }
 
-    /// The sensor: camera and image size.
+    /// The sensor: camera and image size (of the first sensor; later ones are noted and skipped).
     fn sensor(&mut self, e: &Elem) -> Result<()> {
-        match e.need("type")? {
-            "perspective" => {}
-            "thinlens" => self
-                .notes
-                .push(format!("sensor at line {}: thinlens is rendered as a pinhole (no depth of field)", e.line)),
-            t => return Err(e.error(format!("sensor type '{}' is not supported (perspective is)", short(t)))),
-        }
+        sensor::check_type(e, &mut self.notes)?;
         if self.camera {
             self.notes.push(format!("sensor at line {}: only the first sensor is used", e.line));
             return Ok(());
         }
         self.camera = true;
-        let (mut w, mut h) = (768i64, 576i64);
-        if let Some(film) = e.children.iter().find(|c| c.tag == "film") {
-            w = integer(film, "width", w)?;
-            h = integer(film, "height", h)?;
-            if !(1..=32768).contains(&w) || !(1..=32768).contains(&h) {
-                return Err(film.error(format!("image size {w}x{h} must be between 1 and 32768")));
-            }
-        }
-        let fov = match (find(e, "fov"), string(e, "focal_length")?) {
-            (Some(_), _) => float(e, "fov", 0.0)?,
-            (None, Some(f)) => {
-                let mm: f32 = f
-                    .trim()
-                    .trim_end_matches("mm")
-                    .parse()
-                    .map_err(|_| e.error(format!("focal_length '{}' is not a length in mm", short(f))))?;
-                2.0 * (18.0 / mm).atan().to_degrees()
-            }
-            (None, None) => 2.0 * (18.0f32 / 50.0).atan().to_degrees(),
-        };
-        if !(fov > 0.0 && fov < 180.0) {
-            return Err(e.error(format!("fov {fov} must be between 0 and 180 degrees")));
-        }
-        let (wf, hf) = (w as f32, h as f32);
-        let half = (fov.to_radians() / 2.0).tan();
-        let axis = string(e, "fov_axis")?.unwrap_or("x");
-        let tan_v = match axis {
-            "x" => half * hf / wf,
-            "y" => half,
-            "diagonal" => half * hf / (wf * wf + hf * hf).sqrt(),
-            "smaller" if wf < hf => half * hf / wf,
-            "smaller" => half,
-            "larger" if wf > hf => half * hf / wf,
-            "larger" => half,
-            a => return Err(e.error(format!("fov_axis '{}' is not x, y, diagonal, smaller or larger", short(a)))),
-        };
-        let m = transform(e, "to_world")?;
-        let eye = m.transform_point3(Vec3::ZERO);
-        let forward = m.transform_vector3(Vec3::Z);
-        let up = m.transform_vector3(Vec3::Y);
-        let left = m.transform_vector3(Vec3::X);
-        if forward.cross(up).dot(left) > 0.0 {
-            self.notes.push(format!(
-                "sensor at line {}: its transform mirrors the image; plie renders it unmirrored",
-                e.line
-            ));
-        }
-        let camera =
-            Camera { eye, target: eye + forward.normalize_or_zero(), up, fov_deg: 2.0 * tan_v.atan().to_degrees() };
-        camera.validate().map_err(|err| e.error(err.to_string()))?;
+        let (camera, (w, h)) = sensor::camera(e, &mut self.notes)?;
         self.b.camera(camera);
-        self.b.image_size(w as u32, h as u32);
+        self.b.image_size(w, h);
         Ok(())
     }
 
@@ -553,35 +485,8 @@ impl<'a> Loader<'a> {
             }
             return Err(root.error("the scene has no lights: no <shape> has an 'area' emitter".into()));
         }
-        let mut warnings = Vec::new();
-        if !self.other_emitters.is_empty() {
-            warnings.push(format!(
-                "ignored {} emitter(s) plie does not render, only area lights: {}",
-                self.other_emitters.len(),
-                self.other_emitters.join(", ")
-            ));
-        }
-        if !self.changed.is_empty() {
-            self.changed.dedup();
-            let list: Vec<String> = self.changed.iter().map(|(n, how)| format!("'{n}' ({how})")).collect();
-            warnings.push(format!(
-                "materials plie cannot render yet were rendered by their diffuse part: {}",
-                list.join(", ")
-            ));
-        }
-        if !self.dropped.is_empty() {
-            let mut names = self.dropped.clone();
-            names.dedup();
-            warnings.push(format!(
-                "dropped {} shape(s) from shading and shadows: plie does not render glass (or null BSDFs) yet: {}",
-                self.dropped.len(),
-                names.join(", ")
-            ));
-        }
-        if self.spectral {
-            warnings.push("spectra given as wavelength:value pairs were averaged to grey".into());
-        }
-        warnings.extend(self.notes);
+        let warnings =
+            warnings::collect(&self.other_emitters, &mut self.changed, &self.dropped, self.spectral, self.notes);
         lights::add_lights(&mut self.b, &self.emissive).map_err(|z| {
             self.emissive_at[z.index].error("an emissive triangle has zero area: a light must have an area".into())
         })?;

@@ -238,3 +238,18 @@ mod tests {
         assert_eq!(snake_case("diffuseReflectance"), "diffuse_reflectance");
     }
 }
+
+/// Records every element with an `id`; a repeated id is an error.
+pub(super) fn register_ids<'a>(e: &'a Elem, ids: &mut HashMap<String, &'a Elem>) -> Result<()> {
+    for c in &e.children {
+        if c.tag != "ref" {
+            if let Some(id) = c.attr("id") {
+                if ids.insert(id.to_string(), c).is_some() {
+                    return Err(c.error(format!("the id '{}' is used twice", short(id))));
+                }
+            }
+        }
+        register_ids(c, ids)?;
+    }
+    Ok(())
+}
