@@ -20,6 +20,7 @@ pub mod image;
 pub mod input;
 pub mod lights;
 pub mod mitsuba;
+mod mtl;
 pub mod obj;
 mod obj_lines;
 pub(crate) mod plie_file;
