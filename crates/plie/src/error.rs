@@ -24,6 +24,16 @@ pub enum Error {
         /// What is wrong.
         message: String,
     },
+    /// A part of a scene file named by its index is malformed (a glTF mesh primitive or node).
+    #[error("{}: {element}: {message}", path.display())]
+    SceneElement {
+        /// The file.
+        path: PathBuf,
+        /// Which part.
+        element: SceneElement,
+        /// What is wrong.
+        message: String,
+    },
     /// The scene is not usable (no triangles, no lights, NaN coordinates, a bad light polygon ...).
     #[error("invalid scene: {0}")]
     InvalidScene(String),
@@ -62,6 +72,34 @@ pub enum Error {
         /// What went wrong.
         message: String,
     },
+}
+
+/// A part of a scene file, by index ([`Error::SceneElement`]).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum SceneElement {
+    /// glTF `meshes[mesh].primitives[primitive]`; `name` is the mesh's, if it has one.
+    Primitive {
+        /// Index of the mesh.
+        mesh: usize,
+        /// The mesh's name.
+        name: Option<String>,
+        /// Index of the primitive in the mesh.
+        primitive: usize,
+    },
+    /// glTF `nodes[node]`.
+    Node(usize),
+}
+
+impl std::fmt::Display for SceneElement {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            SceneElement::Primitive { mesh, name: Some(n), primitive } => {
+                write!(f, "mesh '{n}' (mesh {mesh}), primitive {primitive}")
+            }
+            SceneElement::Primitive { mesh, name: None, primitive } => write!(f, "mesh {mesh}, primitive {primitive}"),
+            SceneElement::Node(n) => write!(f, "node {n}"),
+        }
+    }
 }
 
 /// Result with [`Error`].

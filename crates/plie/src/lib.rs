@@ -75,7 +75,7 @@ pub use construct::{
     RoundStats,
 };
 pub use environment::{BuildOptions, Environment, Report};
-pub use error::{Error, PlieFileError, Result};
+pub use error::{Error, PlieFileError, Result, SceneElement};
 pub use lie::{Criterion, Grids, MaxBlockers, PlieParams, Propagation, RefineParams, Regions, DEFAULT_BLOCKER_CAP};
 pub use progress::{NoProgress, Progress};
 pub use render::path::{Nee, PathSettings, PathStats};

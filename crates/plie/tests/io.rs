@@ -36,7 +36,8 @@ pub fn load_from(files: &[(&str, &[u8])], name: &str) -> plie::Result<Scene> {
     load_scene(&dir.path().join(name))
 }
 
-/// The error's text, asserting it is an `Error::Parse` naming a file called `file` and, if given, `line`.
+/// The error's text, asserting it is an `Error::Parse` naming a file called `file` and, if given, `line`
+/// (or, without a line, an `Error::SceneElement` of that file: then the element and the message).
 pub fn parse_error(r: plie::Result<Scene>, file: &str, line: Option<usize>) -> String {
     match r {
         Err(e @ Error::Parse { .. }) => {
@@ -46,6 +47,11 @@ pub fn parse_error(r: plie::Result<Scene>, file: &str, line: Option<usize>) -> S
                 assert_eq!(*l, line, "{e}");
             }
             message.clone()
+        }
+        // A part of the file by index (glTF primitives and nodes): the part and the message.
+        Err(Error::SceneElement { path, element, message }) if line.is_none() => {
+            assert_eq!(path.file_name().unwrap(), file);
+            format!("{element}: {message}")
         }
         Err(e) => panic!("expected a parse error, got {e:?}"),
         Ok(s) => panic!("expected an error, got a scene with {} triangles", s.triangle_count()),

@@ -30,7 +30,7 @@ use super::input::{read_bounded, resolve_in_scene, short, LoadOptions, MAX_INPUT
 use super::lights::{self, EmissiveTriangle};
 use super::texture_file::decode_texture;
 use super::{material_warnings, parse_error, scene_name};
-use crate::error::{Error, Result};
+use crate::error::{Error, Result, SceneElement};
 use crate::scene::texture::{Filter, Wrap};
 use crate::scene::{Camera, Material, MaterialId, Scene, SceneBuilder};
 
@@ -48,7 +48,7 @@ pub fn load_gltf_with(path: &Path, opts: LoadOptions) -> Result<Scene> {
     }
     check_glb_header(&bytes).map_err(bad)?;
     let raw = ::gltf::Gltf::from_slice_without_validation(&bytes).map_err(|e| gltf_error(path, e))?;
-    check_primitive_indices(raw.document.as_json()).map_err(bad)?;
+    check_primitive_indices(path, raw.document.as_json())?;
     let document = ::gltf::Document::from_json(raw.document.into_json()).map_err(|e| gltf_error(path, e))?;
     let gltf = ::gltf::Gltf { document, blob: raw.blob };
     let buffers = load_buffers(path, &gltf.document, gltf.blob.clone(), opts)?;
@@ -72,29 +72,34 @@ pub fn load_gltf_with(path: &Path, opts: LoadOptions) -> Result<Scene> {
     stack.reverse();
     while let Some((node, parent)) = stack.pop() {
         if std::mem::replace(&mut seen[node.index()], true) {
-            return Err(bad(format!(
-                "node {} appears twice in the scene graph (a cycle or two parents)",
-                node.index()
-            )));
+            return Err(in_node(path, &node, "appears twice in the scene graph (a cycle or two parents)".into()));
         }
         let world = parent * Mat4::from_cols_array_2d(&node.transform().matrix());
         if let Some(mesh) = node.mesh() {
             for prim in mesh.primitives() {
-                loader.primitive(&mesh, &prim, world).map_err(|m| bad(format!("{}: {m}", describe(&mesh, &prim))))?;
+                loader.primitive(&mesh, &prim, world).map_err(|message| Error::SceneElement {
+                    path: path.to_path_buf(),
+                    element: primitive_element(&mesh, &prim),
+                    message,
+                })?;
             }
         }
         if loader.camera.is_none() {
-            loader.camera(&node, world).map_err(bad)?;
+            loader.camera(&node, world).map_err(|m| in_node(path, &node, m))?;
         }
         stack.extend(node.children().map(|c| (c, world)).collect::<Vec<_>>().into_iter().rev());
     }
     loader.finish(path)
 }
 
-/// "mesh 'name' (mesh 2), primitive 0" for error messages.
-fn describe(mesh: &::gltf::Mesh, prim: &::gltf::Primitive) -> String {
-    let name = mesh.name().map(|n| format!("mesh '{n}' (mesh {})", mesh.index()));
-    format!("{}, primitive {}", name.unwrap_or_else(|| format!("mesh {}", mesh.index())), prim.index())
+/// `prim` of `mesh` as a [`SceneElement`] (errors and warnings name it).
+fn primitive_element(mesh: &::gltf::Mesh, prim: &::gltf::Primitive) -> SceneElement {
+    SceneElement::Primitive { mesh: mesh.index(), name: mesh.name().map(str::to_string), primitive: prim.index() }
+}
+
+/// An error in `node`.
+fn in_node(path: &Path, node: &::gltf::Node, message: String) -> Error {
+    Error::SceneElement { path: path.to_path_buf(), element: SceneElement::Node(node.index()), message }
 }
 
 /// An error of the `gltf` crate as a parse error (with the JSON line for syntax errors).
@@ -113,7 +118,7 @@ fn gltf_error(path: &Path, e: ::gltf::Error) -> Error {
 
 /// The `gltf` crate's validation indexes the accessors of every primitive's `POSITION` unchecked (an
 /// index-out-of-bounds panic in `gltf-json`): check every accessor index of a primitive first.
-fn check_primitive_indices(root: &::gltf::json::Root) -> Result<(), String> {
+fn check_primitive_indices(path: &Path, root: &::gltf::json::Root) -> Result<()> {
     let n = root.accessors.len();
     for (m, mesh) in root.meshes.iter().enumerate() {
         for (p, prim) in mesh.primitives.iter().enumerate() {
@@ -121,9 +126,11 @@ fn check_primitive_indices(root: &::gltf::json::Root) -> Result<(), String> {
             let all = attrs.chain(prim.indices.map(|i| ("indices".to_string(), i.value())));
             for (what, i) in all {
                 if i >= n {
-                    return Err(format!(
-                        "mesh {m}, primitive {p}: {what} names accessor {i}, but the file has {n} accessors"
-                    ));
+                    return Err(Error::SceneElement {
+                        path: path.to_path_buf(),
+                        element: SceneElement::Primitive { mesh: m, name: mesh.name.clone(), primitive: p },
+                        message: format!("{what} names accessor {i}, but the file has {n} accessors"),
+                    });
                 }
             }
         }
@@ -313,7 +320,7 @@ impl Loader<'_> {
             };
             if mat.is_emissive() {
                 self.emissive.push(EmissiveTriangle { id, vertices: [a, b, c], radiance: mat.emission });
-                self.emissive_info.push((describe(mesh, prim), k));
+                self.emissive_info.push((primitive_element(mesh, prim).to_string(), k));
             }
         }
         Ok(())
@@ -440,7 +447,7 @@ impl Loader<'_> {
         let forward = world.transform_vector3(Vec3::NEG_Z).normalize_or_zero();
         let up = world.transform_vector3(Vec3::Y);
         let c = Camera::new(eye, eye + forward, up, p.yfov().to_degrees())
-            .map_err(|e| format!("camera {} of node {}: {e}", cam.index(), node.index()))?;
+            .map_err(|e| format!("camera {}: {e}", cam.index()))?;
         self.camera = Some(c);
         Ok(())
     }

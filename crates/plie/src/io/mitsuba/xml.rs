@@ -226,19 +226,6 @@ pub fn snake_case(s: &str) -> String {
     out
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn names_become_snake_case() {
-        assert_eq!(snake_case("toWorld"), "to_world");
-        assert_eq!(snake_case("fovAxis"), "fov_axis");
-        assert_eq!(snake_case("to_world"), "to_world");
-        assert_eq!(snake_case("diffuseReflectance"), "diffuse_reflectance");
-    }
-}
-
 /// Records every element with an `id`; a repeated id is an error.
 pub(super) fn register_ids<'a>(e: &'a Elem, ids: &mut HashMap<String, &'a Elem>) -> Result<()> {
     for c in &e.children {
@@ -252,4 +239,17 @@ pub(super) fn register_ids<'a>(e: &'a Elem, ids: &mut HashMap<String, &'a Elem>)
         register_ids(c, ids)?;
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn names_become_snake_case() {
+        assert_eq!(snake_case("toWorld"), "to_world");
+        assert_eq!(snake_case("fovAxis"), "fov_axis");
+        assert_eq!(snake_case("to_world"), "to_world");
+        assert_eq!(snake_case("diffuseReflectance"), "diffuse_reflectance");
+    }
 }
