@@ -11,7 +11,7 @@ use plie::internals::compare::answer_diff;
 use plie::internals::render::{HitBuffer, RenderSettings};
 use plie::visibility::bvh::Bvh;
 use plie::visibility::embree::native::{Exclusion, Packet};
-use plie::visibility::{Brute, BvhVisibility, NativeEmbree, Visibility};
+use plie::visibility::{Brute, BvhVisibility, Mode, NativeEmbree, Visibility};
 use plie::Scene;
 
 /// At most this fraction of shadow-ray answers may differ from brute force, and the image's relative

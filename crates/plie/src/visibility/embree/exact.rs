@@ -3,8 +3,8 @@
 //!
 //! Embree's own triangle test is not our watertight test, so Embree never decides a hit. Every
 //! triangle is a primitive of one *user* geometry (`RTC_GEOMETRY_TYPE_USER`) whose bounds are the
-//! triangle's box grown by a tolerance ([`pad`]). The occluded callback reaches the [`ShadowRay`] and
-//! the thread's [`QueryCtx`] through [`Query`], a struct that extends `RTCIntersectContext` (the
+//! triangle's box grown by a tolerance (`pad`). The occluded callback reaches the [`ShadowRay`] and
+//! the thread's [`QueryCtx`] through `Query`, a struct that extends `RTCIntersectContext` (the
 //! pattern Embree 3 documents for passing data to callbacks), calls [`blocks`] and, on a hit, sets
 //! `tfar = -inf` as Embree 3 requires for occlusion. Embree is given the whole segment from `x`
 //! (`tnear = 0`) to `y` (`tfar = 1`), a range containing our open `t` range, and the scene is built

@@ -4,13 +4,13 @@
 //! - [`native`] (`--visibility embree`): Embree's own triangles and triangle test, a light's samples
 //!   from one point answered in packets. The reference a user compares against. **Not exact**: its
 //!   triangle test is Embree's, not our watertight test, so a few shadow-ray answers differ from
-//!   `brute` (tests bound the fraction; [`crate::compare`] measures it).
+//!   `brute` (tests bound the fraction; `compare.rs` measures it).
 //! - [`exact`] (`--visibility embree-exact`): Embree's BVH over padded triangle boxes proposes
 //!   candidates and [`super::blocks`] decides, so it answers exactly as brute force. Kept because it
 //!   is the only exact mode whose traversal is not ours: the exactness suites then check our predicate
 //!   under a second, independent BVH, and it measures what Embree's traversal alone is worth.
 //!
-//! Both own an Embree [`Device`]; [`ffi`] holds the hand-written bindings.
+//! Both own an Embree `Device`; `ffi.rs` holds the hand-written bindings.
 
 pub mod exact;
 mod ffi;

@@ -1,6 +1,6 @@
 //! `--visibility embree`: native Intel Embree 3, the peer a user would compare against (SPEC §5's
 //! comparison with a modern ray tracer). **Not exact**: Embree's triangle test decides, so a few
-//! shadow-ray answers may differ from `brute` (see [`crate::compare`]).
+//! shadow-ray answers may differ from `brute` (see `compare.rs`).
 //!
 //! The scene's triangles are Embree triangle geometry (`RTC_GEOMETRY_TYPE_TRIANGLE`) over shared
 //! vertex and index buffers, built with `RTC_SCENE_FLAG_ROBUST` and `RTC_BUILD_QUALITY_HIGH`. A shadow
