@@ -96,7 +96,8 @@ impl Environment {
     }
 
     /// An environment of an octree and a P-LIE built on it for `scene` (as the construction returns
-    /// them; for the crate's tests and tools).
+    /// them; for the crate's tests and tools: the P-LIE's type is internal, see `plie::internals`).
+    #[doc(hidden)]
     pub fn from_parts(scene: &Scene, octree: Octree, plie: Plie) -> Environment {
         Environment { octree, plie, scene_fingerprint: plie_file::scene_fingerprint(scene), bvh: OnceLock::new() }
     }
@@ -151,7 +152,8 @@ impl Environment {
         &self.octree
     }
 
-    /// The P-LIE.
+    /// The P-LIE (its type is internal, see `plie::internals`).
+    #[doc(hidden)]
     pub fn plie(&self) -> &Plie {
         &self.plie
     }
@@ -179,7 +181,8 @@ impl Environment {
         self.plie.memory_bytes() + self.octree.memory_bytes()
     }
 
-    /// The octree and the P-LIE.
+    /// The octree and the P-LIE (the P-LIE's type is internal, see `plie::internals`).
+    #[doc(hidden)]
     pub fn into_parts(self) -> (Octree, Plie) {
         (self.octree, self.plie)
     }
