@@ -24,7 +24,8 @@ pub enum Error {
         /// What is wrong.
         message: String,
     },
-    /// A part of a scene file named by its index is malformed (a glTF mesh primitive or node).
+    /// A part of a scene file named by its index is malformed (a glTF mesh primitive or node, a PLY
+    /// vertex or face).
     #[error("{}: {element}: {message}", path.display())]
     SceneElement {
         /// The file.
@@ -88,6 +89,16 @@ pub enum SceneElement {
     },
     /// glTF `nodes[node]`.
     Node(usize),
+    /// Record `index` (0-based) of the PLY element `element` (`vertex`, `face`), at `line` in an ASCII
+    /// file.
+    Ply {
+        /// The element's name.
+        element: &'static str,
+        /// The record's index.
+        index: usize,
+        /// Its 1-based line (ASCII files).
+        line: Option<usize>,
+    },
 }
 
 impl std::fmt::Display for SceneElement {
@@ -98,6 +109,8 @@ impl std::fmt::Display for SceneElement {
             }
             SceneElement::Primitive { mesh, name: None, primitive } => write!(f, "mesh {mesh}, primitive {primitive}"),
             SceneElement::Node(n) => write!(f, "node {n}"),
+            SceneElement::Ply { element, index, line: None } => write!(f, "{element} {index}"),
+            SceneElement::Ply { element, index, line: Some(l) } => write!(f, "{element} {index} (line {l})"),
         }
     }
 }

@@ -13,12 +13,20 @@ use glam::{Vec2, Vec3};
 use super::input::{read_bounded, short, MAX_INPUT_BYTES};
 use super::parse_error;
 use super::tri_mesh::TriMesh;
-use crate::error::Result;
+use crate::error::{Error, Result, SceneElement};
 
-/// Reads the PLY file at `path`.
+/// Reads the PLY file at `path`. A problem with one vertex or face is an [`Error::SceneElement`]
+/// naming it; others are [`Error::Parse`] with the line where known.
 pub fn load_ply(path: &Path) -> Result<TriMesh> {
     let bytes = read_bounded(path, MAX_INPUT_BYTES)?;
-    parse_ply(&bytes).map_err(|(line, m)| parse_error(path, line, m))
+    parse_located(&bytes).map_err(|p| match p.record {
+        Some((element, index)) => Error::SceneElement {
+            path: path.to_path_buf(),
+            element: SceneElement::Ply { element, index, line: p.line },
+            message: p.message,
+        },
+        None => parse_error(path, p.line, p.message),
+    })
 }
 
 /// A scalar type of the format.
@@ -84,8 +92,30 @@ enum Format {
 /// An error: the line (where known) and the message.
 type PlyError = (Option<usize>, String);
 
-/// Parses a whole PLY file.
+/// A problem in the file: the line (where known), the record it is in when it is one vertex's or
+/// face's (element and 0-based index), and the message.
+struct Problem {
+    line: Option<usize>,
+    record: Option<(&'static str, usize)>,
+    message: String,
+}
+
+impl From<PlyError> for Problem {
+    fn from((line, message): PlyError) -> Problem {
+        Problem { line, record: None, message }
+    }
+}
+
+/// Parses a whole PLY file; an error is the line (where known) and the message (naming the record).
 pub fn parse_ply(bytes: &[u8]) -> std::result::Result<TriMesh, PlyError> {
+    parse_located(bytes).map_err(|p| match p.record {
+        Some((element, index)) => (p.line, format!("{element} {index} {}", p.message)),
+        None => (p.line, p.message),
+    })
+}
+
+/// [`parse_ply`] with the record of a problem apart.
+fn parse_located(bytes: &[u8]) -> std::result::Result<TriMesh, Problem> {
     let (format, elements, body, header_lines) = header(bytes)?;
     let mut mesh = TriMesh::default();
     let mut source = match format {
@@ -101,7 +131,8 @@ pub fn parse_ply(bytes: &[u8]) -> std::result::Result<TriMesh, PlyError> {
             return Err((
                 None,
                 format!("element '{}' claims {} items, more than the file holds", short(&e.name), e.count),
-            ));
+            )
+                .into());
         }
         match e.name.as_str() {
             "vertex" => read_vertices(e, &mut source, &mut mesh)?,
@@ -121,10 +152,11 @@ pub fn parse_ply(bytes: &[u8]) -> std::result::Result<TriMesh, PlyError> {
         return Err((
             None,
             format!("face index {} out of range: the file has {n} vertices", t.iter().max().unwrap_or(&0)),
-        ));
+        )
+            .into());
     }
     if mesh.triangles.is_empty() {
-        return Err((None, "no faces: the file defines no triangles".into()));
+        return Err((None, "no faces: the file defines no triangles".to_string()).into());
     }
     Ok(mesh)
 }
@@ -208,9 +240,10 @@ impl Source<'_> {
         }
     }
 
+    /// The 1-based line of the value last read (ASCII; `line` counts the newlines passed).
     fn line(&self) -> Option<usize> {
         match self {
-            Source::Ascii { line, .. } => Some(*line),
+            Source::Ascii { line, .. } => Some(*line + 1),
             Source::Binary { .. } => None,
         }
     }
@@ -310,10 +343,10 @@ impl Source<'_> {
     }
 }
 
-fn read_vertices(e: &Element, src: &mut Source, mesh: &mut TriMesh) -> std::result::Result<(), PlyError> {
+fn read_vertices(e: &Element, src: &mut Source, mesh: &mut TriMesh) -> std::result::Result<(), Problem> {
     let find = |names: &[&str]| e.properties.iter().position(|p| p.list.is_none() && names.contains(&p.name.as_str()));
     let (Some(x), Some(y), Some(z)) = (find(&["x"]), find(&["y"]), find(&["z"])) else {
-        return Err((None, "the vertex element has no x, y, z properties".into()));
+        return Err((None, "the vertex element has no x, y, z properties".to_string()).into());
     };
     let u = find(&["u", "s", "texture_u", "texture_s"]);
     let v = find(&["v", "t", "texture_v", "texture_t"]);
@@ -330,7 +363,8 @@ fn read_vertices(e: &Element, src: &mut Source, mesh: &mut TriMesh) -> std::resu
         src.end_item()?;
         let p = Vec3::new(values[x] as f32, values[y] as f32, values[z] as f32);
         if !p.is_finite() {
-            return Err((src.line(), format!("vertex {} is not finite in single precision", mesh.positions.len())));
+            let (line, record) = (src.line(), Some(("vertex", mesh.positions.len())));
+            return Err(Problem { line, record, message: "is not finite in single precision".into() });
         }
         mesh.positions.push(p);
         if let Some((u, v)) = uv {
@@ -340,7 +374,7 @@ fn read_vertices(e: &Element, src: &mut Source, mesh: &mut TriMesh) -> std::resu
     Ok(())
 }
 
-fn read_faces(e: &Element, src: &mut Source, mesh: &mut TriMesh) -> std::result::Result<(), PlyError> {
+fn read_faces(e: &Element, src: &mut Source, mesh: &mut TriMesh) -> std::result::Result<(), Problem> {
     let list = e
         .properties
         .iter()
@@ -358,12 +392,14 @@ fn read_faces(e: &Element, src: &mut Source, mesh: &mut TriMesh) -> std::result:
             for _ in 0..n {
                 let v = src.value(p.value)?;
                 if v < 0.0 || v.fract() != 0.0 || v > u32::MAX as f64 {
-                    return Err((src.line(), format!("face {f} has the index {v}, not a vertex index")));
+                    let message = format!("has the index {v}, not a vertex index");
+                    return Err(Problem { line: src.line(), record: Some(("face", f)), message });
                 }
                 poly.push(v as u32);
             }
             if n < 3 {
-                return Err((src.line(), format!("face {f} has {n} vertices; a face needs at least 3")));
+                let message = format!("has {n} vertices; a face needs at least 3");
+                return Err(Problem { line: src.line(), record: Some(("face", f)), message });
             }
             for k in 1..n - 1 {
                 mesh.triangles.push([poly[0], poly[k], poly[k + 1]]);
@@ -411,6 +447,25 @@ property float z\nproperty float u\nproperty float v\nelement face 1\nproperty l
             assert_eq!(m.positions[1], Vec3::X);
             assert_eq!(m.triangles, vec![[0, 1, 2]]);
         }
+    }
+
+    /// A bad face or vertex is a typed error naming the record, its line and the file.
+    #[test]
+    fn bad_records_are_scene_element_errors() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("q.ply");
+        std::fs::write(&path, QUAD.replace("4 0 1 2 3", "2 0 1")).unwrap();
+        match load_ply(&path) {
+            Err(Error::SceneElement { path: p, element, message }) => {
+                assert_eq!(p, path);
+                assert_eq!(element, SceneElement::Ply { element: "face", index: 0, line: Some(17) });
+                assert!(message.contains("a face needs at least 3"), "{message}");
+            }
+            other => panic!("expected face 0's error: {:?}", other.err()),
+        }
+        // The untyped form keeps the record in the message.
+        let (line, m) = parse_ply(QUAD.replace("4 0 1 2 3", "2 0 1").as_bytes()).unwrap_err();
+        assert_eq!((line, m.as_str()), (Some(17), "face 0 has 2 vertices; a face needs at least 3"));
     }
 
     #[test]
