@@ -316,7 +316,12 @@ fn print_answers(s: &QueryStats) {
     if l.queries > 0 {
         let share = |n: u64| 100.0 * n as f64 / l.queries as f64;
         eprintln!("(point, light)   {:>12} {:>7}", "pairs", "share");
-        for (name, n) in [("whole umbra", l.whole_umbra), ("whole lit", l.whole_lit), ("per sample", l.per_sample)] {
+        for (name, n) in [
+            ("whole umbra", l.whole_umbra),
+            ("whole lit", l.whole_lit),
+            ("gathered", l.gathered),
+            ("per sample", l.per_sample),
+        ] {
             eprintln!("  {name:<14} {n:>12} {:>6.1}%", share(n));
         }
     }

@@ -42,8 +42,11 @@ const LANES: usize = 8;
 #[derive(Clone, Debug, Default)]
 pub struct Fan {
     origin: Vec3,
-    dirs: Vec<Vec3>,
-    lens: Vec<f32>,
+    /// Per ray, in the order of [`Fan::float_lanes`]: its direction `d = y - x`, its length, the
+    /// watertight test's `1 / d[kz]` and the inverse direction for box tests ([`inverse`]).
+    all: [Vec<f32>; 8],
+    /// Per ray: the watertight test's axis `kz` (the largest component of `d`).
+    all_kz: Vec<u32>,
     /// The exact tests, built on first use (`None` until then).
     rays: Vec<Option<ShadowRay>>,
     /// Active rays: their indices, and their directions and lengths in lanes (padded with zeros to a
@@ -60,14 +63,9 @@ pub struct Fan {
     aix: Vec<f32>,
     aiy: Vec<f32>,
     aiz: Vec<f32>,
-    /// Per ray: the inverse direction for box tests.
-    invs: Vec<Vec3>,
     /// The lane masks of a walk down a box hierarchy ([`Fan::narrow`]): [`WALK_LEVELS`] masks of
     /// `open.len()` words each.
     masks: Vec<u64>,
-    /// Per ray: the watertight test's axis `kz` (the largest component of `d`) and `1 / d[kz]`.
-    kzs: Vec<u8>,
-    szs: Vec<f32>,
     /// Bit `j` of word `j / 64`: active lane `j` is still open (not found occluded).
     open: Vec<u64>,
     /// Bit per active lane: the fast test could not prove a miss for the current triangle.
@@ -82,37 +80,54 @@ impl Fan {
     /// Starts the fan of `rays` (directions computed exactly as [`ShadowRay::new`] does).
     pub fn set(&mut self, rays: &LightRays) {
         let x = rays.origin;
+        let n = rays.targets.len();
         self.origin = x;
-        self.dirs.clear();
-        self.lens.clear();
-        self.kzs.clear();
-        self.szs.clear();
-        self.invs.clear();
-        for y in rays.targets {
+        for v in &mut self.all {
+            v.resize(n, 0.0);
+        }
+        self.all_kz.resize(n, 0);
+        let [dx, dy, dz, len, sz, ix, iy, iz] = &mut self.all;
+        for (k, y) in rays.targets.iter().enumerate() {
             let d = *y - x;
-            self.invs.push(inverse(d));
-            self.dirs.push(d);
-            self.lens.push(d.length());
-            // As `RayTest::new` chooses it.
-            let a = d.abs();
-            let kz = if a.x >= a.y && a.x >= a.z {
-                0
-            } else if a.y >= a.z {
-                1
+            (dx[k], dy[k], dz[k]) = (d.x, d.y, d.z);
+        }
+        // Lane by lane as `Vec3::length`, `inverse` and `RayTest::new` compute them, in loops the
+        // compiler vectorises.
+        let (dx, dy, dz) = (&dx[..n], &dy[..n], &dz[..n]);
+        for k in 0..n {
+            len[k] = ((dx[k] * dx[k]) + (dy[k] * dy[k]) + (dz[k] * dz[k])).sqrt();
+        }
+        for (inv, d) in [(&mut ix[..n], dx), (&mut iy[..n], dy), (&mut iz[..n], dz)] {
+            for k in 0..n {
+                inv[k] = inverse(d[k]);
+            }
+        }
+        let kzs = &mut self.all_kz[..n];
+        for k in 0..n {
+            let (ax, ay, az) = (dx[k].abs(), dy[k].abs(), dz[k].abs());
+            let (kz, dk) = if ax >= ay && ax >= az {
+                (0, dx[k])
+            } else if ay >= az {
+                (1, dy[k])
             } else {
-                2
+                (2, dz[k])
             };
-            self.kzs.push(kz as u8);
-            self.szs.push(1.0 / d[kz]);
+            kzs[k] = kz;
+            sz[k] = 1.0 / dk;
         }
         self.rays.clear();
-        self.rays.resize(rays.targets.len(), None);
+        self.rays.resize(n, None);
         self.live = 0;
     }
 
-    /// The active rays' per-lane `f32` arrays.
-    fn float_lanes(&mut self) -> [&mut Vec<f32>; 8] {
-        [
+    /// Makes the rays `k` with `want(k)` the active ones.
+    pub fn select(&mut self, want: impl Fn(usize) -> bool) {
+        let n = self.all_kz.len();
+        self.idx.clear();
+        self.idx.extend((0..n as u32).filter(|&k| want(k as usize)));
+        let m = self.idx.len();
+        let padded = m.div_ceil(LANES) * LANES;
+        let active = [
             &mut self.ax,
             &mut self.ay,
             &mut self.az,
@@ -121,38 +136,24 @@ impl Fan {
             &mut self.aix,
             &mut self.aiy,
             &mut self.aiz,
-        ]
-    }
-
-    /// Makes the rays `k` with `want(k)` the active ones.
-    pub fn select(&mut self, want: impl Fn(usize) -> bool) {
-        for v in self.float_lanes() {
-            v.clear();
-        }
-        self.idx.clear();
-        self.akz.clear();
-        for k in 0..self.dirs.len() {
-            if want(k) {
-                let d = self.dirs[k];
-                self.idx.push(k as u32);
-                self.ax.push(d.x);
-                self.ay.push(d.y);
-                self.az.push(d.z);
-                self.al.push(self.lens[k]);
-                self.asz.push(self.szs[k]);
-                self.akz.push(u32::from(self.kzs[k]));
-                let i = self.invs[k];
-                self.aix.push(i.x);
-                self.aiy.push(i.y);
-                self.aiz.push(i.z);
+        ];
+        for (lanes, from) in active.into_iter().zip(&self.all) {
+            lanes.resize(padded, 0.0);
+            if m == n {
+                lanes[..m].copy_from_slice(from);
+            } else {
+                for (l, &k) in lanes.iter_mut().zip(&self.idx) {
+                    *l = from[k as usize];
+                }
             }
-        }
-        let m = self.idx.len();
-        let padded = m.div_ceil(LANES) * LANES;
-        for v in self.float_lanes() {
-            v.resize(padded, 0.0);
+            // The padding lanes: zero (a zero direction meets no box and no triangle's cone).
+            lanes[m..].fill(0.0);
         }
         self.akz.resize(padded, 0);
+        for (l, &k) in self.akz.iter_mut().zip(&self.idx) {
+            *l = self.all_kz[k as usize];
+        }
+        self.akz[m..].fill(0);
         let words = m.div_ceil(64);
         self.open.clear();
         self.open.resize(words, u64::MAX);
@@ -288,15 +289,19 @@ impl Fan {
 /// Masks of a walk down a list's box hierarchy ([`Fan::narrow`]): one per level, and the triangles'.
 const WALK_LEVELS: usize = super::list_boxes::MAX_LEVELS + 1;
 
-/// The inverse of a direction for the slab test, with a non-finite component (a zero or tiny
-/// component) replaced by `±f32::MAX`. A product with it is then never NaN, and the slab it gives
+/// The inverse of a direction's component for the slab test, with a non-finite one (of a zero or
+/// tiny component) replaced by `±f32::MAX`. A product with it is then never NaN, and the slab it gives
 /// is the whole line where the box's slab holds the origin and empty (up to the segment's tiny
 /// motion along that axis, which is far below the boxes' growth by the construction tolerance)
 /// where it does not, as [`crate::geometry::Segment`]'s parallel case decides.
 #[inline]
-fn inverse(d: Vec3) -> Vec3 {
-    let i = d.recip();
-    Vec3::select(i.is_finite_mask(), i, Vec3::splat(f32::MAX).copysign(i))
+fn inverse(d: f32) -> f32 {
+    let i = 1.0 / d;
+    if i.is_finite() {
+        i
+    } else {
+        f32::MAX.copysign(i)
+    }
 }
 
 /// The active rays' inverse directions in lanes.
@@ -510,4 +515,6 @@ pub struct LightScratch {
     pub lists: Vec<u32>,
     /// The light's footprints on the leaf's faces.
     pub feet: Vec<super::footprint::FaceFootprint>,
+    /// The `(start, len)` of the face-grid cell lists gathered in `lists` (to keep each list once).
+    pub ranges: Vec<(u32, u32)>,
 }

@@ -103,7 +103,10 @@ pub struct LightAnswers {
     /// Pairs whose every ray was answered without a triangle test, some of them lit (no blocker in
     /// their cell and no triangle of the leaf in the pyramid to the light).
     pub whole_lit: u64,
-    /// Pairs that tested candidate triangles against their rays.
+    /// Pairs whose rays were all tested against the short lists of every cell under the light's
+    /// footprints, without finding each ray's own cell.
+    pub gathered: u64,
+    /// Pairs whose rays each found their own cell or list, then tested candidate triangles.
     pub per_sample: u64,
 }
 
@@ -112,6 +115,7 @@ impl std::ops::AddAssign for LightAnswers {
         self.queries += o.queries;
         self.whole_umbra += o.whole_umbra;
         self.whole_lit += o.whole_lit;
+        self.gathered += o.gathered;
         self.per_sample += o.per_sample;
     }
 }

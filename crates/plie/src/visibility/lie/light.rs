@@ -6,7 +6,7 @@
 
 use super::super::bvh::segment_occluded;
 use super::super::fan::{Fan, LightScratch, Pyramid};
-use super::super::footprint::{footprints, FaceFootprint};
+use super::super::footprint::footprints;
 use super::super::list_boxes::{Chunked, ListVisitor};
 use super::super::query::SEGMENT_EPS;
 use super::super::{Answer, LightRays, Mode, QueryCtx, Visibility};
@@ -14,12 +14,13 @@ use super::{exit_face_of, LieVisibility};
 use crate::geometry::Aabb;
 use crate::lie::frame::{in_triangles, FaceFrame};
 use crate::lie::grid;
-use crate::lie::{Cell, Plie, RecordKind};
+use crate::lie::{Cell, Plie, RecordKind, CHUNKED_MIN};
 use crate::octree::LeafId;
 use crate::scene::TriId;
+use glam::Vec3;
 
 /// Summed-area tables of the face grids of `plie` (see the field `sat` of `LieVisibility`).
-pub(super) fn grid_tables(plie: &Plie) -> (Vec<u32>, Vec<[u32; 2]>) {
+pub(super) fn grid_tables(plie: &Plie) -> (Vec<u32>, Vec<[u32; 3]>) {
     let mut start = Vec::with_capacity(plie.grids.len());
     let mut sat = Vec::new();
     for grid in &plie.grids {
@@ -30,42 +31,63 @@ pub(super) fn grid_tables(plie: &Plie) -> (Vec<u32>, Vec<[u32; 2]>) {
         start.push(sat.len() as u32);
         let g = grid.res as usize;
         let base = sat.len();
-        sat.resize(base + (g + 1) * (g + 1), [0, 0]);
+        sat.resize(base + (g + 1) * (g + 1), [0, 0, 0]);
         for j in 0..g {
             for i in 0..g {
-                let (not_lit, not_umbra) = match plie.cell(grid, j * g + i) {
-                    Cell::Umbra => (1, 0),
-                    Cell::Scene => (1, 1),
-                    Cell::Blockers(l) => (u32::from(!l.is_empty()), 1),
+                let counts = match plie.cell(grid, j * g + i) {
+                    Cell::Umbra => [1, 0, 1],
+                    Cell::Scene => [1, 1, 1],
+                    Cell::Blockers(l) => [u32::from(!l.is_empty()), 1, 0],
                 };
                 let at = |i: usize, j: usize| base + j * (g + 1) + i;
                 let (a, b, c) = (sat[at(i, j + 1)], sat[at(i + 1, j)], sat[at(i, j)]);
-                sat[at(i + 1, j + 1)] = [a[0] + b[0] - c[0] + not_lit, a[1] + b[1] - c[1] + not_umbra];
+                sat[at(i + 1, j + 1)] = std::array::from_fn(|w| a[w] + b[w] - c[w] + counts[w]);
             }
         }
     }
     (start, sat)
 }
 
+/// What the footprints of a light on the faces of a point's leaf decide ([`LieVisibility::whole_light`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Whole {
+    /// Every sample's ray is occluded: each leaves the leaf through a face without a record or
+    /// through umbra cells.
+    Umbra,
+    /// No blocker list can hit any sample (every footprint lies in lit cells, or on records with
+    /// empty lists): only the leaf's own triangles remain to test.
+    Lit,
+    /// Every footprint lies in cells (or on records without a grid) with short lists, whose keys
+    /// are gathered: each sample's own list is one of them, so testing every sample against all of
+    /// them (and the leaf's own triangles) finds exactly its blockers.
+    Lists,
+    /// The samples must be classified one by one.
+    Mixed,
+}
+
 impl LieVisibility<'_> {
-    /// The whole light at once, from its footprints on the faces of `leaf` ([`footprints`]), if
-    /// they decide it: `Some(true)` if every sample's ray is occluded (each leaves the leaf through
-    /// a face without a record or through umbra cells), `Some(false)` if no blocker list can hit
-    /// any of them (every footprint lies in lit cells, or on records with empty lists) so that only
-    /// the leaf's own triangles remain to test, `None` otherwise.
+    /// The samples of the light polygon `poly` (the light of `rays` or a part of it) at once, from
+    /// its footprints on the faces of `leaf` ([`footprints`]), if they decide them ([`Whole`]). For
+    /// [`Whole::Lists`], the keys of the lists (see [`CELL_KEY`]) are added to `sc.lists`, each
+    /// distinct list once (other outcomes may have added some too).
     fn whole_light(
         &self,
         leaf: LeafId,
         bounds: &Aabb,
         rays: &LightRays,
-        feet: &mut Vec<FaceFootprint>,
-    ) -> Option<bool> {
-        let light = &self.scene.lights[rays.light.idx()];
-        let all_exit = footprints(bounds, rays.origin, &light.vertices, SEGMENT_EPS, feet);
-        let (mut lit, mut umbra) = (true, all_exit);
-        for fp in feet.iter() {
+        poly: &[Vec3],
+        sc: &mut LightScratch,
+    ) -> Whole {
+        let all_exit = footprints(bounds, rays.origin, poly, SEGMENT_EPS, &mut sc.feet);
+        let (mut lit, mut umbra, mut listed) = (true, all_exit, self.mode == Mode::Grid);
+        for f in 0..sc.feet.len() {
+            let fp = sc.feet[f];
             let Some(ri) = self.plie.record_id(leaf, fp.face, rays.light) else {
                 lit = false;
+                listed = false;
+                if !umbra {
+                    return Whole::Mixed;
+                }
                 continue;
             };
             let record = &self.plie.records[ri];
@@ -85,22 +107,100 @@ impl LieVisibility<'_> {
                         |w: usize| at(i1 + 1, j1 + 1)[w] + at(i0, j0)[w] - at(i0, j1 + 1)[w] - at(i1 + 1, j0)[w];
                     lit &= count(0) == 0;
                     umbra &= count(1) == 0;
+                    listed &= count(2) == 0;
+                    if listed && count(0) > 0 {
+                        listed = self.gather_cells(ri, g, (i0, i1), (j0, j1), sc);
+                    }
                 }
                 None => {
-                    lit &= record.kind == RecordKind::Listed && record.blockers_len == 0;
+                    let empty = record.kind == RecordKind::Listed && record.blockers_len == 0;
+                    lit &= empty;
                     umbra = false;
+                    if listed && !empty {
+                        listed = record.kind == RecordKind::Listed && (record.blockers_len as usize) < CHUNKED_MIN;
+                        sc.lists.push(ri as u32);
+                    }
                 }
             }
-            if !lit && !umbra {
-                return None;
+            if !lit && !umbra && !listed {
+                return Whole::Mixed;
             }
         }
         if umbra {
-            Some(true)
+            Whole::Umbra
         } else if lit {
-            Some(false)
+            Whole::Lit
+        } else if listed {
+            Whole::Lists
         } else {
-            None
+            Whole::Mixed
+        }
+    }
+
+    /// Adds the distinct non-empty lists of the cells `[i0, i1] x [j0, j1]` of record `ri`'s grid
+    /// (`g` cells a side, none of them umbra or scene) to `sc.lists`; false if one is long (walked
+    /// better by the rays that need it, one by one).
+    fn gather_cells(
+        &self,
+        ri: usize,
+        g: usize,
+        (i0, i1): (usize, usize),
+        (j0, j1): (usize, usize),
+        sc: &mut LightScratch,
+    ) -> bool {
+        let first = self.plie.grids[ri].cells_start as usize;
+        for j in j0..=j1 {
+            for i in i0..=i1 {
+                let c = first + j * g + i;
+                let range = self.plie.cells[c];
+                if range.1 == 0 || sc.ranges.contains(&range) {
+                    continue;
+                }
+                if range.1 as usize >= CHUNKED_MIN {
+                    return false;
+                }
+                sc.ranges.push(range);
+                sc.lists.push(c as u32 | CELL_KEY);
+            }
+        }
+        true
+    }
+
+    /// [`Whole::Lists`]: every sample against every gathered list, then the leaf's own triangles,
+    /// as a fan culled by the pyramid.
+    fn lists_only(&self, leaf: LeafId, rays: &LightRays, sc: &mut LightScratch, out: &mut [bool], ctx: &mut QueryCtx) {
+        out.fill(false);
+        ctx.stats.lights.queries += 1;
+        let lanes_before = ctx.stats.lane_tests;
+        sc.fan.set(rays);
+        sc.fan.pyramid.set(rays.origin, &self.scene.lights[rays.light.idx()], self.pad * 10.0);
+        sc.fan.select(|_| true);
+        ctx.begin_query();
+        let before = ctx.stats.triangle_tests;
+        for &key in &sc.lists {
+            self.fan_list(rays, self.list_of(key), true, &mut sc.fan, out, ctx);
+        }
+        ctx.stats.blocker_tests += ctx.stats.triangle_tests - before;
+        sc.path.clear();
+        sc.path.extend(out.iter().map(|&o| if o { path::LIST_HIT } else { path::LIST }));
+        sc.fan.select(|k| !out[k]);
+        let before = ctx.stats.triangle_tests;
+        let (start, len) = self.own[leaf.idx()];
+        let own = self.own_boxes.of(leaf.idx(), &self.own_tris[start as usize..(start + len) as usize]);
+        self.fan_list(rays, own, false, &mut sc.fan, out, ctx);
+        ctx.stats.own_leaf_tests += ctx.stats.triangle_tests - before;
+        for (k, &o) in out.iter().enumerate() {
+            let a = match (sc.path[k], o) {
+                (path::LIST_HIT, _) => Answer::BlockersHit,
+                (_, true) => Answer::OwnLeaf,
+                _ => Answer::BlockersMiss,
+            };
+            ctx.stats.answered(a, o);
+        }
+        if ctx.stats.lane_tests == lanes_before {
+            ctx.stats.lights.whole_lit += 1;
+        } else {
+            ctx.stats.lights.gathered += 1;
         }
     }
 
@@ -124,8 +224,10 @@ impl LieVisibility<'_> {
         let mut scratch = std::mem::take(&mut ctx.light);
         let sc = &mut scratch;
         let bounds = self.octree.leaf_bounds(leaf);
-        match self.whole_light(leaf, &bounds, rays, &mut sc.feet) {
-            Some(true) => {
+        sc.lists.clear();
+        sc.ranges.clear();
+        match self.whole_light(leaf, &bounds, rays, &self.scene.lights[rays.light.idx()].vertices, sc) {
+            Whole::Umbra => {
                 out.fill(true);
                 ctx.stats.lights.queries += 1;
                 ctx.stats.lights.whole_umbra += 1;
@@ -135,19 +237,25 @@ impl LieVisibility<'_> {
                 ctx.light = scratch;
                 return;
             }
-            Some(false) => {
+            Whole::Lit => {
                 self.own_only(leaf, rays, sc, out, ctx);
                 ctx.light = scratch;
                 return;
             }
-            None => {}
+            Whole::Lists => {
+                self.lists_only(leaf, rays, sc, out, ctx);
+                ctx.light = scratch;
+                return;
+            }
+            Whole::Mixed => {}
         }
+        sc.lists.clear();
+        sc.ranges.clear();
         sc.fan.set(rays);
         sc.path.clear();
         sc.path.resize(n, path::LIT);
         sc.list.clear();
         sc.list.resize(n, u32::MAX);
-        sc.lists.clear();
         out.fill(false);
         let x = rays.origin;
         // Per face: the record (`None`: no record), looked up once.
@@ -227,7 +335,7 @@ impl LieVisibility<'_> {
             if out.iter().all(|&o| o) {
                 ctx.stats.lights.whole_umbra += 1;
             } else {
-                ctx.stats.lights.per_sample += 1;
+                ctx.stats.lights.gathered += 1;
             }
         } else {
             let lanes_before = ctx.stats.lane_tests;

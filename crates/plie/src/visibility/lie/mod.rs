@@ -61,10 +61,11 @@ pub struct LieVisibility<'a> {
     own_boxes: ListBoxes,
     /// In `grid`: per record, where its grid's tables start in `sat` (`u32::MAX`: no grid).
     sat_start: Vec<u32>,
-    /// Summed-area tables of each face grid, `(res + 1)^2` pairs each: the number of cells that are
-    /// not lit (umbra, scene or a non-empty list) and of cells that are not umbra, in the cells
-    /// `[0, i) x [0, j)`. A footprint's cells are then counted in four lookups.
-    sat: Vec<[u32; 2]>,
+    /// Summed-area tables of each face grid, `(res + 1)^2` triples each: the number of cells that
+    /// are not lit (umbra, scene or a non-empty list), of cells that are not umbra, and of cells
+    /// without a list (umbra or scene), in the cells `[0, i) x [0, j)`. A footprint's cells are then
+    /// counted in four lookups.
+    sat: Vec<[u32; 3]>,
 }
 
 impl<'a> LieVisibility<'a> {
