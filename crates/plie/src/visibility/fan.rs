@@ -19,8 +19,8 @@
 use glam::Vec3;
 
 use super::query::SEGMENT_EPS;
-use super::{LightRays, QueryCtx, ShadowRay};
-use crate::geometry::{Aabb, Triangle};
+use super::{LightRays, QueryCtx};
+use crate::geometry::{Aabb, RayTest, Triangle};
 use crate::scene::{Scene, TriId};
 
 pub use super::pyramid::Pyramid;
@@ -42,13 +42,15 @@ const LANES: usize = 8;
 #[derive(Clone, Debug, Default)]
 pub struct Fan {
     origin: Vec3,
-    /// Per ray, in the order of [`Fan::float_lanes`]: its direction `d = y - x`, its length, the
-    /// watertight test's `1 / d[kz]` and the inverse direction for box tests ([`inverse`]).
+    /// Per ray, in the order of the active lanes' arrays (`ax` ... `aiz`): its direction `d = y - x`,
+    /// its length, the watertight test's `1 / d[kz]` and the inverse direction for box tests
+    /// ([`inverse`]).
     all: [Vec<f32>; 8],
     /// Per ray: the watertight test's axis `kz` (the largest component of `d`).
     all_kz: Vec<u32>,
-    /// The exact tests, built on first use (`None` until then).
-    rays: Vec<Option<ShadowRay>>,
+    /// The exact tests, built on first use: valid where bit `k` of `built` is set.
+    tests: Vec<RayTest>,
+    built: Vec<u64>,
     /// Active rays: their indices, and their directions and lengths in lanes (padded with zeros to a
     /// multiple of [`LANES`]).
     idx: Vec<u32>,
@@ -77,7 +79,7 @@ pub struct Fan {
 }
 
 impl Fan {
-    /// Starts the fan of `rays` (directions computed exactly as [`ShadowRay::new`] does).
+    /// Starts the fan of `rays` (directions computed exactly as [`super::ShadowRay::new`] does).
     pub fn set(&mut self, rays: &LightRays) {
         let x = rays.origin;
         let n = rays.targets.len();
@@ -91,32 +93,40 @@ impl Fan {
             let d = *y - x;
             (dx[k], dy[k], dz[k]) = (d.x, d.y, d.z);
         }
-        // Lane by lane as `Vec3::length`, `inverse` and `RayTest::new` compute them, in loops the
-        // compiler vectorises.
-        let (dx, dy, dz) = (&dx[..n], &dy[..n], &dz[..n]);
-        for k in 0..n {
-            len[k] = ((dx[k] * dx[k]) + (dy[k] * dy[k]) + (dz[k] * dz[k])).sqrt();
-        }
-        for (inv, d) in [(&mut ix[..n], dx), (&mut iy[..n], dy), (&mut iz[..n], dz)] {
-            for k in 0..n {
-                inv[k] = inverse(d[k]);
-            }
-        }
         let kzs = &mut self.all_kz[..n];
-        for k in 0..n {
-            let (ax, ay, az) = (dx[k].abs(), dy[k].abs(), dz[k].abs());
-            let (kz, dk) = if ax >= ay && ax >= az {
-                (0, dx[k])
-            } else if ay >= az {
-                (1, dy[k])
-            } else {
-                (2, dz[k])
+        let mut done = 0;
+        #[cfg(target_arch = "x86_64")]
+        if std::arch::is_x86_feature_detected!("avx2") {
+            // SAFETY: AVX2 is available (checked above).
+            done = unsafe {
+                ray_lanes_avx(
+                    [&dx[..n], &dy[..n], &dz[..n]],
+                    [&mut len[..n], &mut sz[..n], &mut ix[..n], &mut iy[..n], &mut iz[..n]],
+                    kzs,
+                )
             };
-            kzs[k] = kz;
-            sz[k] = 1.0 / dk;
         }
-        self.rays.clear();
-        self.rays.resize(n, None);
+        for k in done..n {
+            let d = Vec3::new(dx[k], dy[k], dz[k]);
+            len[k] = d.length();
+            (ix[k], iy[k], iz[k]) = (inverse(d.x), inverse(d.y), inverse(d.z));
+            // As `RayTest::new` chooses it.
+            let a = d.abs();
+            let kz = if a.x >= a.y && a.x >= a.z {
+                0
+            } else if a.y >= a.z {
+                1
+            } else {
+                2
+            };
+            kzs[k] = kz as u32;
+            sz[k] = 1.0 / d[kz];
+        }
+        if self.tests.len() < n {
+            self.tests.resize(n, RayTest::new(Vec3::ZERO, Vec3::X, 0.0, 1.0));
+        }
+        self.built.clear();
+        self.built.resize(n.div_ceil(64), 0);
         self.live = 0;
     }
 
@@ -233,9 +243,12 @@ impl Fan {
             let j = w * 64 + bits.trailing_zeros() as usize;
             bits &= bits - 1;
             let k = self.idx[j] as usize;
-            let ray = *self.rays[k].get_or_insert_with(|| rays.ray(k));
+            if self.built[k / 64] & (1 << (k % 64)) == 0 {
+                self.tests[k] = rays.ray(k).test;
+                self.built[k / 64] |= 1 << (k % 64);
+            }
             ctx.stats.triangle_tests += 1;
-            if ray.test.hit(tri).is_some() {
+            if self.tests[k].hit(tri).is_some() {
                 self.open[w] &= !(1u64 << (j % 64));
                 self.live -= 1;
                 out[k] = true;
@@ -302,6 +315,58 @@ fn inverse(d: f32) -> f32 {
     } else {
         f32::MAX.copysign(i)
     }
+}
+
+/// The per-ray values of [`Fan::set`] from the directions `[dx, dy, dz]`, eight rays at a time, as the
+/// scalar loop computes them (the same IEEE operations in the same order, so the same bits): into
+/// `[len, sz, ix, iy, iz]` and `kz`. Returns how many rays it did (a multiple of eight); the caller
+/// does the rest.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx,avx2")]
+unsafe fn ray_lanes_avx(d: [&[f32]; 3], out: [&mut [f32]; 5], kz: &mut [u32]) -> usize {
+    use std::arch::x86_64::*;
+    let [dx, dy, dz] = d;
+    let [len, sz, ix, iy, iz] = out;
+    let n = [dx.len(), dy.len(), dz.len(), len.len(), sz.len(), ix.len(), iy.len(), iz.len(), kz.len()]
+        .into_iter()
+        .min()
+        .unwrap_or(0)
+        / LANES
+        * LANES;
+    let sign = _mm256_set1_ps(-0.0);
+    let (inf, max) = (_mm256_set1_ps(f32::INFINITY), _mm256_set1_ps(f32::MAX));
+    let one = _mm256_set1_ps(1.0);
+    let inverse = |v: __m256| {
+        let i = _mm256_div_ps(one, v);
+        let finite = _mm256_cmp_ps::<_CMP_LT_OQ>(_mm256_andnot_ps(sign, i), inf);
+        _mm256_blendv_ps(_mm256_or_ps(max, _mm256_and_ps(sign, i)), i, finite)
+    };
+    let mut k = 0;
+    while k < n {
+        // SAFETY: k + LANES <= n <= every array's length.
+        unsafe {
+            let (x, y, z) = (
+                _mm256_loadu_ps(dx.as_ptr().add(k)),
+                _mm256_loadu_ps(dy.as_ptr().add(k)),
+                _mm256_loadu_ps(dz.as_ptr().add(k)),
+            );
+            let dot = _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(x, x), _mm256_mul_ps(y, y)), _mm256_mul_ps(z, z));
+            _mm256_storeu_ps(len.as_mut_ptr().add(k), _mm256_sqrt_ps(dot));
+            _mm256_storeu_ps(ix.as_mut_ptr().add(k), inverse(x));
+            _mm256_storeu_ps(iy.as_mut_ptr().add(k), inverse(y));
+            _mm256_storeu_ps(iz.as_mut_ptr().add(k), inverse(z));
+            let (ax, ay, az) = (_mm256_andnot_ps(sign, x), _mm256_andnot_ps(sign, y), _mm256_andnot_ps(sign, z));
+            let c0 = _mm256_and_ps(_mm256_cmp_ps::<_CMP_GE_OQ>(ax, ay), _mm256_cmp_ps::<_CMP_GE_OQ>(ax, az));
+            let c1 = _mm256_cmp_ps::<_CMP_GE_OQ>(ay, az);
+            let dk = _mm256_blendv_ps(_mm256_blendv_ps(z, y, c1), x, c0);
+            _mm256_storeu_ps(sz.as_mut_ptr().add(k), _mm256_div_ps(one, dk));
+            let k12 = _mm256_blendv_ps(_mm256_set1_ps(2.0), one, c1);
+            let kk = _mm256_cvttps_epi32(_mm256_blendv_ps(k12, _mm256_setzero_ps(), c0));
+            _mm256_storeu_si256(kz.as_mut_ptr().add(k).cast(), kk);
+        }
+        k += LANES;
+    }
+    n
 }
 
 /// The active rays' inverse directions in lanes.
@@ -517,4 +582,48 @@ pub struct LightScratch {
     pub feet: Vec<super::footprint::FaceFootprint>,
     /// The `(start, len)` of the face-grid cell lists gathered in `lists` (to keep each list once).
     pub ranges: Vec<(u32, u32)>,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The eight-lane ray values are the scalar loop's, bit for bit, on ordinary, tied, zero, signed
+    /// zero, tiny and huge components.
+    #[test]
+    fn ray_lanes_match_the_scalar_loop() {
+        #[cfg(target_arch = "x86_64")]
+        if std::arch::is_x86_feature_detected!("avx2") {
+            let special = [0.0, -0.0, 1.0, -1.0, 1e-30, -1e-38, 3e38, -2.5, 0.1, 7.0, -7.0, 1e-45];
+            let mut state = 11u64;
+            let mut rnd = || {
+                state = crate::render::sampler::mix64(state);
+                special[(state % special.len() as u64) as usize] * if state & 1 << 40 != 0 { 1.0 } else { 3.3 }
+            };
+            let n = 4096;
+            let (dx, dy, dz): (Vec<f32>, Vec<f32>, Vec<f32>) = (0..n).map(|_| (rnd(), rnd(), rnd())).collect();
+            let mut out: [Vec<f32>; 5] = std::array::from_fn(|_| vec![0.0; n]);
+            let mut kz = vec![0u32; n];
+            let [len, sz, ix, iy, iz] = &mut out;
+            // SAFETY: AVX2 is available (checked above).
+            let done = unsafe { ray_lanes_avx([&dx, &dy, &dz], [len, sz, ix, iy, iz], &mut kz) };
+            assert_eq!(done, n);
+            for k in 0..n {
+                let d = Vec3::new(dx[k], dy[k], dz[k]);
+                let a = d.abs();
+                let want_kz = if a.x >= a.y && a.x >= a.z {
+                    0
+                } else if a.y >= a.z {
+                    1
+                } else {
+                    2
+                };
+                let want = [d.length(), 1.0 / d[want_kz], inverse(d.x), inverse(d.y), inverse(d.z)];
+                for (w, (got, want)) in out.iter().map(|v| v[k]).zip(want).enumerate() {
+                    assert_eq!(got.to_bits(), want.to_bits(), "ray {k} {d}: value {w}: {got} against {want}");
+                }
+                assert_eq!(kz[k], want_kz as u32, "ray {k} {d}");
+            }
+        }
+    }
 }
