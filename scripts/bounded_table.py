@@ -3,9 +3,10 @@
 options) per scene, before and after the blocker cap, and for several caps.
 
 Usage: scripts/bounded_table.py --binary target/release/plie [--before PATH] [--caps 1024,none]
-       [--scenes A,B] [--shared DIR] [--timeout S] [--threads T]
-Each build runs once under `/usr/bin/time -v` (peak RSS) with a timeout; a build that does not finish
-is reported with its elapsed time. Prints one markdown row per (scene, binary, cap) and writes the raw
+       [--scenes A,B] [--shared DIR] [--timeout S] [--threads T] [--repeat N] [--before-label L]
+Each build runs under `/usr/bin/time -v` (peak RSS, CPU time of the whole process) with a timeout,
+`--repeat N` times interleaved with the other binaries' (the row shows the run with the median
+seconds); a build that does not finish is reported with its elapsed time. Prints one markdown row per (scene, binary, cap) and writes the raw
 figures as JSON lines to stderr.
 """
 import argparse, json, os, re, subprocess, sys, tempfile, time
@@ -32,6 +33,8 @@ def run(binary, scene, cap, timeout, threads, out):
     v = json.loads(p.stdout)
     m = re.search(r"Maximum resident set size \(kbytes\): (\d+)", p.stderr)
     v["max_rss"] = int(m.group(1)) * 1024 if m else None
+    cpu = [re.search(rf"{k} time \(seconds\): ([0-9.]+)", p.stderr) for k in ("User", "System")]
+    v["cpu"] = sum(float(c.group(1)) for c in cpu) if all(cpu) else None
     v["wall"] = wall
     v["cap"] = cap
     os.remove(out)
@@ -45,9 +48,17 @@ def row(label, v):
         return f"| {v['scene']} | {label} | error: {v['error']} | | | | | |"
     tri = v["triangles"]
     mb = lambda b: f"{b / 2**20:,.0f}" if b is not None else "?"
+    cpu = f"{v['cpu']:.2f} | {1e6 * v['cpu'] / tri:.1f}" if v.get("cpu") is not None else "? | ?"
     return (f"| {os.path.basename(v['scene'])} | {label} | {v['build_seconds']:.2f} | {1e6 * v['build_seconds'] / tri:.1f} | "
-            f"{mb(v['max_rss'])} | {mb(v['file_bytes'])} | {v['blockers_total'] + v['grid_blockers_total']:,} | "
+            f"{cpu} | {mb(v['max_rss'])} | {mb(v['file_bytes'])} | {v['blockers_total'] + v['grid_blockers_total']:,} | "
             f"{v.get('records_scene', '-')} of {v['records']:,} |")
+
+
+def median_run(runs):
+    """The run with the median `build_seconds` (the first if any failed or timed out)."""
+    if any(r.get("timeout") or "error" in r for r in runs):
+        return runs[0]
+    return sorted(runs, key=lambda r: r["build_seconds"])[len(runs) // 2]
 
 
 def main():
@@ -59,26 +70,34 @@ def main():
     p.add_argument("--shared", default="../shared")
     p.add_argument("--timeout", type=float, default=600)
     p.add_argument("--threads", type=int, default=None)
+    p.add_argument("--repeat", type=int, default=1, help="runs per build, interleaved; the median is shown")
+    p.add_argument("--before-label", default="before")
     a = p.parse_args()
     if a.scenes:
         scenes = a.scenes.split(",")
     else:
         scenes = [os.path.join(a.shared, "scenes", s) for s in SHARED] + STRESS
-    print("| scene | build | seconds | µs per triangle | peak RSS (MiB) | file (MiB) | blocker refs | scene records |")
-    print("|---|---|---|---|---|---|---|---|")
+    print("| scene | build | seconds | µs per triangle | CPU s | CPU µs per triangle | peak RSS (MiB) | file (MiB) | "
+          "blocker refs | scene records |")
+    print("|---|---|---|---|---|---|---|---|---|---|")
     with tempfile.TemporaryDirectory() as d:
         out = os.path.join(d, "x.plie")
         for s in scenes:
             runs = []
             if a.before:
-                runs.append(("before", a.before, None))
+                runs.append((a.before_label, a.before, None))
             runs += [(f"cap {c}", a.binary, c) for c in a.caps.split(",")]
-            for label, binary, cap in runs:
-                v = run(binary, s, cap, a.timeout, a.threads, out)
-                print(json.dumps({k: v.get(k) for k in ["scene", "cap", "build_seconds", "wall", "max_rss",
-                      "file_bytes", "records", "records_scene", "records_over_budget", "blockers_total",
-                      "grid_blockers_total", "peak_memory_bytes", "timeout", "leaves"]}), file=sys.stderr)
-                print(row(label, v), flush=True)
+            results = [[] for _ in runs]
+            for _ in range(a.repeat):
+                for k, (label, binary, cap) in enumerate(runs):
+                    v = run(binary, s, cap, a.timeout, a.threads, out)
+                    print(json.dumps({k: v.get(k) for k in ["scene", "cap", "build_seconds", "wall", "cpu", "max_rss",
+                          "file_bytes", "records", "records_scene", "records_over_budget", "blockers_total",
+                          "grid_blockers_total", "peak_memory_bytes", "timeout", "leaves"]} | {"label": label}),
+                          file=sys.stderr)
+                    results[k].append(v)
+            for (label, _, _), rs in zip(runs, results):
+                print(row(label, median_run(rs)), flush=True)
 
 
 if __name__ == "__main__":

@@ -5,12 +5,16 @@
 
 mod support;
 
+use plie::geometry::RayTest;
 use plie::internals::construct::{build_bounded, Interrupted, Limits};
-use plie::internals::lie::{Cell, PlieParams, RecordKind};
+use plie::internals::lie::frame::{FaceFrame, UNITS};
+use plie::internals::lie::grid::cell_box;
+use plie::internals::lie::{Cell, PlieParams, Propagation, RecordKind, Regions};
 use plie::internals::render::{NoProgress, Progress};
 use plie::octree::Octree;
+use plie::visibility::query::SEGMENT_EPS;
 use plie::visibility::{Brute, Mode, QueryCtx, Visibility};
-use plie::{Environment, Scene};
+use plie::{Environment, LightId, Scene, TriId};
 
 /// The stress scene at test size: 12 x 12 rods (1,452 triangles).
 fn balusters() -> Scene {
@@ -86,6 +90,114 @@ fn capped_records_are_answered_by_the_scene_exactly() {
         assert!((0..(g.res * g.res) as usize).all(|c| matches!(p.cell(g, c), Cell::Umbra | Cell::Scene)), "{r:?}");
     }
     assert!(check_exact(&scene, &built, 20_000) > 100);
+}
+
+/// True if a scene triangle other than the light's blocks `f -> y` (brute force).
+fn blocked(scene: &Scene, light: LightId, f: glam::Vec3, y: glam::Vec3) -> bool {
+    let ray = RayTest::new(f, y - f, SEGMENT_EPS, 1.0 - SEGMENT_EPS);
+    (0..scene.triangles.len() as u32)
+        .map(TriId)
+        .any(|t| scene.tri_light[t.idx()] != Some(light) && ray.hit(&scene.triangles[t.idx()]).is_some())
+}
+
+/// A capped record's umbra comes from the blockers of its subset that could fill a grid cell alone,
+/// as convex polygons without a union (`construct::regions::face_umbra_cover`): every point of its
+/// umbra triangles and of its grid's umbra cells, and every face removed as dark (corners included),
+/// is blocked from every light point sampled. Without propagation, so that every removal is one the
+/// regions decided.
+/// Checks the umbra of the capped records of `scene` built with `params` (propagation off) against
+/// brute force; returns (capped records, umbra points, umbra cells, removed faces) checked.
+fn check_capped_umbra(scene: &Scene, params: PlieParams, rng: &mut support::TestRng) -> [usize; 4] {
+    let params = PlieParams { propagation: Propagation::Off, ..params };
+    let built = build(scene, params, Limits::default());
+    let bare = build(scene, PlieParams { regions: Regions::Skip, ..params }, Limits::default());
+    let (p, name) = (&built.plie, &scene.name);
+    let (mut umbra_pts, mut cells, mut removed) = (0, 0, 0);
+    for r in &bare.plie.records {
+        let light = &scene.lights[r.light.idx()];
+        let b = built.octree.leaf_bounds(r.leaf);
+        let frame = FaceFrame::new(r.face, &b);
+        let light_pt = |rng: &mut support::TestRng| light.sample(glam::Vec2::new(rng.f32(), rng.f32()));
+        let Some(ri) = p.record_id(r.leaf, r.face, r.light) else {
+            removed += 1;
+            for k in 0..8 {
+                let x = glam::DVec2::new((k & 1) as f64, ((k >> 1) & 1) as f64) * UNITS;
+                let (f, y) = (frame.point(x).as_vec3(), light_pt(rng));
+                assert!(blocked(scene, r.light, f, y), "{name}: removed record {r:?} sees {y} from {f}");
+            }
+            continue;
+        };
+        if p.records[ri].kind != RecordKind::Scene {
+            continue;
+        }
+        for t in p.umbra_of(ri).iter().take(4) {
+            let c = glam::DVec2::new((t[0][0] + t[1][0] + t[2][0]) as f64, (t[0][1] + t[1][1] + t[2][1]) as f64) / 3.0;
+            let (f, y) = (frame.point(c).as_vec3(), light_pt(rng));
+            assert!(blocked(scene, r.light, f, y), "{name}: umbra point {f} of {r:?} sees {y}");
+            umbra_pts += 1;
+        }
+        let g = p.grids[ri];
+        for c in 0..(g.res * g.res) {
+            if p.cell(&g, c as usize) != Cell::Umbra {
+                continue;
+            }
+            cells += 1;
+            let q = r.face.face_corners(&cell_box(r.face, &b, g.res, c % g.res, c / g.res));
+            for k in 0..6 {
+                let (u, v) = if k < 4 { ((k & 1) as f32, (k >> 1) as f32) } else { (rng.f32(), rng.f32()) };
+                let (f, y) = (q[0] + (q[1] - q[0]) * u + (q[3] - q[0]) * v, light_pt(rng));
+                assert!(blocked(scene, r.light, f, y), "{name}: umbra cell {c} of {r:?}: {f} sees {y}");
+            }
+        }
+    }
+    [p.scene_records(), umbra_pts, cells, removed]
+}
+
+/// A capped record's umbra comes from the blockers of its subset that could fill a grid cell alone,
+/// as convex polygons without a union (`construct::regions::face_umbra_cover`): every point of its
+/// umbra triangles and of its grid's umbra cells, and every face removed as dark (corners included),
+/// is blocked from every light point sampled. Without propagation, so that every removal is one the
+/// regions decided.
+#[test]
+fn capped_records_umbra_cells_and_removals_are_dark() {
+    let mut rng = support::TestRng(0xcab);
+    let mut total = [0; 4];
+    for name in plie::scene::builtin::NAMES.into_iter().chain(["balusters-12"]) {
+        let scene = plie::scene::builtin::load(name).unwrap();
+        let params = PlieParams { blocker_cap: Some(12), ..PlieParams::default() };
+        let counts = check_capped_umbra(&scene, params, &mut rng);
+        total = std::array::from_fn(|k| total[k] + counts[k]);
+    }
+    let [capped, umbra_pts, cells, removed] = total;
+    eprintln!(
+        "{capped} capped records: checked {umbra_pts} umbra points, {cells} umbra cells; {removed} removed faces"
+    );
+    assert!(capped > 1000 && umbra_pts > 50 && cells > 20 && removed > 20, "{total:?}: a weak test");
+}
+
+/// The same, and every exact mode against brute force, on the real scenes with the default cap.
+#[test]
+#[ignore = "exhaustive tier (real scenes): cargo test --workspace -- --ignored"]
+fn capped_p_lies_of_the_shared_scenes_are_exact() {
+    if support::shared_scenes().is_none() {
+        eprintln!("../shared/scenes absent: skipped");
+        return;
+    }
+    let mut rng = support::TestRng(0x5ca1e);
+    let params = PlieParams { blocker_cap: Some(plie::DEFAULT_BLOCKER_CAP), ..PlieParams::default() };
+    for scene in support::load_shared() {
+        let built = build(&scene, params, Limits::default());
+        let n = if scene.triangles.len() > 100_000 { 2_000 } else { 10_000 };
+        let scene_answers = check_exact(&scene, &built, n);
+        eprintln!("{}: {scene_answers} of {n} x 4 rays answered by the scene BVH", scene.name);
+        if scene.triangles.len() <= 70_000 {
+            let [capped, umbra_pts, cells, removed] = check_capped_umbra(&scene, params, &mut rng);
+            eprintln!(
+                "{}: {capped} capped, {umbra_pts} umbra points, {cells} umbra cells, {removed} removed",
+                scene.name
+            );
+        }
+    }
 }
 
 #[test]

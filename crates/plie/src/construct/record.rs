@@ -79,11 +79,15 @@ pub(super) fn face_record(
     let mut blockers = Vec::new();
     let cap = params.blocker_cap.map(|c| c as usize);
     let gathered = gather_blockers(scene, octree, &shaft, light_id, cap, scratch, &mut blockers);
-    // Capped: `blockers` is a subset, whose umbra is a subset of the true umbra (still sound); its
-    // penumbra is not needed.
+    // Capped: `blockers` is a subset, whose umbra is a subset of the true umbra (still sound); only
+    // what can fill a cell of the record's grid (or the face) is computed, its penumbra not at all.
     let regions = params.has_regions().then(|| {
-        let f = if gathered.capped { regions::face_umbra } else { regions::face_regions };
-        f(scene, face, &b, light, &blockers, &shaft, tol, abs_scale)
+        if gathered.capped {
+            let cell = crate::lie::frame::UNITS / grid::UMBRA_MIN_RES as f64;
+            regions::face_umbra_cover(scene, face, &b, light, &blockers, &shaft, (tol, abs_scale), cell)
+        } else {
+            regions::face_regions(scene, face, &b, light, &blockers, &shaft, tol, abs_scale)
+        }
     });
     let (record, state) = if let Some(reg) = regions.as_ref().filter(|r| r.full_umbra) {
         (None, FaceState::Dark { budget: propagation::dark_budget(face, &b, light, reg, tols) })

@@ -16,6 +16,10 @@ use crate::geometry::Aabb;
 /// bounded by their box planes only beyond this.
 pub const MAX_POINTS: usize = 16;
 
+/// Vertices of the stack buffers [`Shaft::clips_triangle`] clips in when the shaft has at most
+/// `SMALL_CLIP - 3` planes.
+const SMALL_CLIP: usize = 48;
+
 /// A closed half-space `n . p <= d`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Plane {
@@ -118,24 +122,38 @@ impl Shaft {
         if inside.iter().any(|&i| i) {
             return true;
         }
-        let mut buf_a = [DVec3::ZERO; 3 + 2 * MAX_POINTS * MAX_POINTS];
-        let mut buf_b = buf_a;
+        // Clipping a convex polygon by a plane adds at most one vertex: a small buffer (cheap to
+        // clear) holds every polygon when the shaft has few planes, as it always has in practice.
+        if 3 + self.planes.len() <= SMALL_CLIP {
+            self.clip_nonempty(tri, &mut [DVec3::ZERO; SMALL_CLIP], &mut [DVec3::ZERO; SMALL_CLIP])
+        } else {
+            let big = 3 + 2 * MAX_POINTS * MAX_POINTS;
+            self.clip_nonempty(tri, &mut vec![DVec3::ZERO; big], &mut vec![DVec3::ZERO; big])
+        }
+    }
+
+    /// True if `tri` clipped by every plane keeps a point, clipping in the buffers `buf_a`, `buf_b`.
+    fn clip_nonempty(&self, tri: &[Vec3; 3], buf_a: &mut [DVec3], buf_b: &mut [DVec3]) -> bool {
         let mut len = 3;
         for (o, v) in buf_a.iter_mut().zip(tri) {
             *o = v.as_dvec3();
         }
-        let (mut cur, mut next) = (&mut buf_a, &mut buf_b);
+        let (mut cur, mut next) = (buf_a, buf_b);
         for p in &self.planes {
             let mut out = 0;
             for i in 0..len {
                 let a = cur[i];
                 let b = cur[(i + 1) % len];
                 let (da, db) = (p.distance(a), p.distance(b));
-                if da <= 0.0 && out < next.len() {
+                // The buffer is full (never for a convex polygon): keep the triangle, conservatively.
+                if out + 2 > next.len() {
+                    return true;
+                }
+                if da <= 0.0 {
                     next[out] = a;
                     out += 1;
                 }
-                if (da <= 0.0) != (db <= 0.0) && out < next.len() {
+                if (da <= 0.0) != (db <= 0.0) {
                     let t = da / (da - db);
                     next[out] = a + (b - a) * t;
                     out += 1;

@@ -103,7 +103,7 @@ pub struct LightAnswers {
     /// Pairs whose every ray was answered without a triangle test, some of them lit (no blocker in
     /// their cell and no triangle of the leaf in the pyramid to the light).
     pub whole_lit: u64,
-    /// Pairs whose rays were all tested against the short lists of every cell under the light's
+    /// Pairs whose rays were all tested against the lists of every cell under the light's
     /// footprints, without finding each ray's own cell.
     pub gathered: u64,
     /// Pairs whose rays each found their own cell or list, then tested candidate triangles.

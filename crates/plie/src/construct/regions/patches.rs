@@ -2,8 +2,6 @@
 //! through, so their union casts more umbra than each alone. Groups neighbouring blockers into
 //! coplanar convex patches whose umbra is computed as one blocker's.
 
-use std::collections::hash_map::{Entry, HashMap};
-
 use glam::{DVec2, DVec3};
 
 use crate::geometry::clip::{hull2, signed_area2};
@@ -40,41 +38,45 @@ pub(super) fn fused_patches(scene: &Scene, blockers: &[TriId], r: f64) -> Vec<Ve
         }
         i
     }
-    let mut edges: HashMap<EdgeKey, (usize, u32)> = HashMap::new();
-    for (i, &t) in blockers.iter().enumerate() {
+    // Edges sorted by key (then by blocker and edge): each run of equal keys is one shared edge, its
+    // first entry the blocker that every later one is tried against.
+    let mut edges: Vec<(EdgeKey, u32)> = Vec::with_capacity(3 * blockers.len());
+    for &t in blockers {
         let v = scene.triangles[t.idx()].v;
-        for e in 0..3 {
-            match edges.entry(edge_key(v[e], v[(e + 1) % 3])) {
-                Entry::Occupied(mut o) => {
-                    let (j, n) = *o.get();
-                    o.insert((j, n + 1));
-                    let (Some(ni), Some(nj)) = (normals[i], normals[j]) else { continue };
-                    let far = tris[i][(e + 2) % 3];
-                    let near = *tris[j].iter().find(|p| !tris[i].contains(p)).unwrap_or(&tris[j][0]);
-                    let (p, q) = (tris[i][e], tris[i][(e + 1) % 3]);
-                    let side = |x: DVec3| nj.dot((q - p).cross(x - p));
-                    if ni.dot(nj).abs() > 1.0 - 1e-12
-                        && nj.dot(far - tris[j][0]).abs() <= 0.01 * r
-                        && side(far) * side(near) < 0.0
-                    {
-                        let (a, b) = (root(&mut parent, i), root(&mut parent, j));
-                        parent[a] = b;
-                    }
-                }
-                Entry::Vacant(slot) => {
-                    slot.insert((i, 1));
-                }
+        edges.extend((0..3).map(|e| (edge_key(v[e], v[(e + 1) % 3]), 0)));
+    }
+    for (k, x) in edges.iter_mut().enumerate() {
+        x.1 = k as u32;
+    }
+    edges.sort_unstable();
+    // Per edge `3 i + e`: used by one blocker only.
+    let mut once = vec![false; edges.len()];
+    for run in edges.chunk_by(|a, b| a.0 == b.0) {
+        let j = (run[0].1 / 3) as usize;
+        once[run[0].1 as usize] = run.len() == 1;
+        for &(_, k) in &run[1..] {
+            let (i, e) = ((k / 3) as usize, (k % 3) as usize);
+            let (Some(ni), Some(nj)) = (normals[i], normals[j]) else { continue };
+            let far = tris[i][(e + 2) % 3];
+            let near = *tris[j].iter().find(|p| !tris[i].contains(p)).unwrap_or(&tris[j][0]);
+            let (p, q) = (tris[i][e], tris[i][(e + 1) % 3]);
+            let side = |x: DVec3| nj.dot((q - p).cross(x - p));
+            if ni.dot(nj).abs() > 1.0 - 1e-12
+                && nj.dot(far - tris[j][0]).abs() <= 0.01 * r
+                && side(far) * side(near) < 0.0
+            {
+                let (a, b) = (root(&mut parent, i), root(&mut parent, j));
+                parent[a] = b;
             }
         }
     }
-    let mut groups: HashMap<usize, Vec<usize>> = HashMap::new();
-    for i in 0..tris.len() {
-        let g = root(&mut parent, i);
-        groups.entry(g).or_default().push(i);
-    }
-    let mut out = Vec::new();
-    let mut members: Vec<Vec<usize>> = groups.into_values().filter(|m| m.len() >= 2).collect();
+    let roots: Vec<usize> = (0..tris.len()).map(|i| root(&mut parent, i)).collect();
+    let mut order: Vec<usize> = (0..tris.len()).collect();
+    order.sort_by_key(|&i| (roots[i], i));
+    let mut members: Vec<Vec<usize>> =
+        order.chunk_by(|&a, &b| roots[a] == roots[b]).filter(|m| m.len() >= 2).map(<[usize]>::to_vec).collect();
     members.sort_unstable();
+    let mut out = Vec::new();
     for m in members {
         let t0 = tris[m[0]];
         let Some(n) = normals[m[0]] else { continue };
@@ -100,11 +102,7 @@ pub(super) fn fused_patches(scene: &Scene, blockers: &[TriId], r: f64) -> Vec<Ve
             })
         };
         let boundary_ok = m.iter().all(|&i| {
-            let v = scene.triangles[blockers[i].idx()].v;
-            (0..3).all(|e| {
-                let once = edges.get(&edge_key(v[e], v[(e + 1) % 3])).is_some_and(|x| x.1 == 1);
-                !once || (on_hull(to2(tris[i][e])) && on_hull(to2(tris[i][(e + 1) % 3])))
-            })
+            (0..3).all(|e| !once[3 * i + e] || (on_hull(to2(tris[i][e])) && on_hull(to2(tris[i][(e + 1) % 3]))))
         });
         if boundary_ok {
             out.push(hull.iter().map(|p| t0[0] + e1 * p.x + e2 * p.y).collect());

@@ -113,6 +113,39 @@ impl Setup<'_> {
         Some((umbra, snap(&s.b), heights))
     }
 
+    /// False if the umbra of the convex polygon `poly` alone cannot contain a face square of `side`
+    /// units grown by the margin: the intersection of the boxes of its projections from the light's
+    /// vertices (which holds its umbra) is narrower than that. True when a point of `poly` is as high
+    /// as a light vertex (no cheap bound).
+    pub(super) fn may_cover(&self, poly: &[DVec3], side: f64) -> bool {
+        // The umbra lies in every projection; a convex polygon containing a square of side `a`
+        // contains its inscribed disc, and a convex polygon's inradius is at most twice its area over
+        // its perimeter.
+        let need = side + 2.0 * self.margin - 1.0;
+        let (mut lo, mut hi) = (DVec2::splat(f64::NEG_INFINITY), DVec2::splat(f64::INFINITY));
+        let mut q = [DVec2::ZERO; 8];
+        if poly.len() > q.len() {
+            return true;
+        }
+        for &(v, hv) in &self.light {
+            let (mut a, mut b) = (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY));
+            for (k, &p) in poly.iter().enumerate() {
+                if self.frame.height(p) >= hv {
+                    return true;
+                }
+                q[k] = self.frame.project(v, hv, p);
+                (a, b) = (a.min(q[k]), b.max(q[k]));
+            }
+            (lo, hi) = (lo.max(a), hi.min(b));
+            let q = &q[..poly.len()];
+            let perimeter: f64 = (0..q.len()).map(|k| (q[(k + 1) % q.len()] - q[k]).length()).sum();
+            if signed_area2(q).abs() < 0.5 * need * perimeter {
+                return false;
+            }
+        }
+        (hi - lo).cmpge(DVec2::splat(need)).all()
+    }
+
     /// The shadow region of one blocker (dilated, snapped, counter-clockwise).
     pub(super) fn shadow_of(&self, tri: &[DVec3; 3], s: &mut Scratch) -> Shadow {
         s.poly.clear();
