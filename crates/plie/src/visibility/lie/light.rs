@@ -1,172 +1,25 @@
 //! The per-light query of the P-LIE modes (issue 21): all `N` samples of one light from one shaded
 //! point at once ([`Visibility::occluded_light`](super::super::Visibility::occluded_light)). The light's
-//! footprints on the leaf's faces ([`super::super::footprint`]) answer the whole light where they lie
-//! in lit cells or in umbra; otherwise each sample finds its exit face, record and cell as the
-//! per-ray query does (SPEC §5), and the candidates are tested as a fan ([`super::super::fan`]).
+//! footprints on the leaf's faces ([`super::whole`]) answer the whole light where they lie in lit
+//! cells or in umbra, or gather the lists of the cells under them; otherwise each sample finds its
+//! exit face, record and cell as the per-ray query does (SPEC §5). The candidates are tested as a
+//! fan ([`super::super::fan`]).
 
 use super::super::bvh::segment_occluded;
 use super::super::fan::{Fan, LightScratch, Pyramid};
-use super::super::footprint::footprints;
 use super::super::list_boxes::{Chunked, ListVisitor};
 use super::super::query::SEGMENT_EPS;
 use super::super::{Answer, LightRays, Mode, QueryCtx, Visibility};
+use super::whole::{Whole, CELL_KEY};
 use super::{exit_face_of, LieVisibility};
 use crate::geometry::Aabb;
 use crate::lie::frame::{in_triangles, FaceFrame};
 use crate::lie::grid;
-use crate::lie::{Cell, Plie, RecordKind};
+use crate::lie::{Cell, RecordKind};
 use crate::octree::LeafId;
 use crate::scene::TriId;
-use glam::Vec3;
-
-/// Summed-area tables of the face grids of `plie` (see the field `sat` of `LieVisibility`).
-pub(super) fn grid_tables(plie: &Plie) -> (Vec<u32>, Vec<[u32; 3]>) {
-    let mut start = Vec::with_capacity(plie.grids.len());
-    let mut sat = Vec::new();
-    for grid in &plie.grids {
-        if grid.res == 0 {
-            start.push(u32::MAX);
-            continue;
-        }
-        start.push(sat.len() as u32);
-        let g = grid.res as usize;
-        let base = sat.len();
-        sat.resize(base + (g + 1) * (g + 1), [0, 0, 0]);
-        for j in 0..g {
-            for i in 0..g {
-                let counts = match plie.cell(grid, j * g + i) {
-                    Cell::Umbra => [1, 0, 1],
-                    Cell::Scene => [1, 1, 1],
-                    Cell::Blockers(l) => [u32::from(!l.is_empty()), 1, 0],
-                };
-                let at = |i: usize, j: usize| base + j * (g + 1) + i;
-                let (a, b, c) = (sat[at(i, j + 1)], sat[at(i + 1, j)], sat[at(i, j)]);
-                sat[at(i + 1, j + 1)] = std::array::from_fn(|w| a[w] + b[w] - c[w] + counts[w]);
-            }
-        }
-    }
-    (start, sat)
-}
-
-/// What the footprints of a light on the faces of a point's leaf decide ([`LieVisibility::whole_light`]).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum Whole {
-    /// Every sample's ray is occluded: each leaves the leaf through a face without a record or
-    /// through umbra cells.
-    Umbra,
-    /// No blocker list can hit any sample (every footprint lies in lit cells, or on records with
-    /// empty lists): only the leaf's own triangles remain to test.
-    Lit,
-    /// Every footprint lies in cells (or on records without a grid) with lists of at most
-    /// [`GATHER_MAX`] triangles, whose keys
-    /// are gathered: each sample's own list is one of them, so testing every sample against all of
-    /// them (and the leaf's own triangles) finds exactly its blockers.
-    Lists,
-    /// The samples must be classified one by one.
-    Mixed,
-}
 
 impl LieVisibility<'_> {
-    /// The samples of the light polygon `poly` (the light of `rays` or a part of it) at once, from
-    /// its footprints on the faces of `leaf` ([`footprints`]), if they decide them ([`Whole`]). For
-    /// [`Whole::Lists`], the keys of the lists (see [`CELL_KEY`]) are added to `sc.lists`, each
-    /// distinct list once (other outcomes may have added some too).
-    fn whole_light(
-        &self,
-        leaf: LeafId,
-        bounds: &Aabb,
-        rays: &LightRays,
-        poly: &[Vec3],
-        sc: &mut LightScratch,
-    ) -> Whole {
-        let all_exit = footprints(bounds, rays.origin, poly, SEGMENT_EPS, &mut sc.feet);
-        let (mut lit, mut umbra, mut listed) = (true, all_exit, self.mode == Mode::Grid);
-        for f in 0..sc.feet.len() {
-            let fp = sc.feet[f];
-            let Some(ri) = self.plie.record_id(leaf, fp.face, rays.light) else {
-                lit = false;
-                listed = false;
-                if !umbra {
-                    return Whole::Mixed;
-                }
-                continue;
-            };
-            let record = &self.plie.records[ri];
-            match self.sat_start.get(ri).copied().filter(|&s| s != u32::MAX) {
-                Some(start) => {
-                    let g = self.plie.grids[ri].res as usize;
-                    let k = fp.face.axis();
-                    let (u, v) = crate::lie::frame::face_axes(k);
-                    let cell = |x: f64, axis: usize| {
-                        let (lo, hi) = (bounds.min[axis] as f64, bounds.max[axis] as f64);
-                        (((x - lo) / (hi - lo) * g as f64).max(0.0) as usize).min(g - 1)
-                    };
-                    let (i0, i1) = (cell(fp.rect[0], u), cell(fp.rect[1], u));
-                    let (j0, j1) = (cell(fp.rect[2], v), cell(fp.rect[3], v));
-                    let at = |i: usize, j: usize| self.sat[start as usize + j * (g + 1) + i];
-                    let count =
-                        |w: usize| at(i1 + 1, j1 + 1)[w] + at(i0, j0)[w] - at(i0, j1 + 1)[w] - at(i1 + 1, j0)[w];
-                    lit &= count(0) == 0;
-                    umbra &= count(1) == 0;
-                    listed &= count(2) == 0;
-                    if listed && count(0) > 0 {
-                        listed = self.gather_cells(ri, g, (i0, i1), (j0, j1), sc);
-                    }
-                }
-                None => {
-                    let empty = record.kind == RecordKind::Listed && record.blockers_len == 0;
-                    lit &= empty;
-                    umbra = false;
-                    if listed && !empty {
-                        listed = record.kind == RecordKind::Listed && (record.blockers_len as usize) < GATHER_MAX;
-                        sc.lists.push(ri as u32);
-                    }
-                }
-            }
-            if !lit && !umbra && !listed {
-                return Whole::Mixed;
-            }
-        }
-        if umbra {
-            Whole::Umbra
-        } else if lit {
-            Whole::Lit
-        } else if listed {
-            Whole::Lists
-        } else {
-            Whole::Mixed
-        }
-    }
-
-    /// Adds the distinct non-empty lists of the cells `[i0, i1] x [j0, j1]` of record `ri`'s grid
-    /// (`g` cells a side, none of them umbra or scene) to `sc.lists`; false if one is longer than
-    /// [`GATHER_MAX`].
-    fn gather_cells(
-        &self,
-        ri: usize,
-        g: usize,
-        (i0, i1): (usize, usize),
-        (j0, j1): (usize, usize),
-        sc: &mut LightScratch,
-    ) -> bool {
-        let first = self.plie.grids[ri].cells_start as usize;
-        for j in j0..=j1 {
-            for i in i0..=i1 {
-                let c = first + j * g + i;
-                let range = self.plie.cells[c];
-                if range.1 == 0 || sc.ranges.contains(&range) {
-                    continue;
-                }
-                if range.1 as usize >= GATHER_MAX {
-                    return false;
-                }
-                sc.ranges.push(range);
-                sc.lists.push(c as u32 | CELL_KEY);
-            }
-        }
-        true
-    }
-
     /// [`Whole::Lists`]: every sample against every gathered list, then the leaf's own triangles,
     /// as a fan culled by the pyramid.
     fn lists_only(&self, leaf: LeafId, rays: &LightRays, sc: &mut LightScratch, out: &mut [bool], ctx: &mut QueryCtx) {
@@ -417,16 +270,6 @@ mod path {
 /// Fewer samples than this are asked ray by ray: with so few, sharing work does not pay (measured at
 /// 4 samples per light, `plie bench --soft-shadows`).
 const FAN_MIN: usize = 8;
-
-/// Longest list a light's footprints gather ([`Whole::Lists`]); a light over a longer one is answered
-/// sample by sample, whose rays walk that list's hierarchy alone. Measured (callgrind of the query at
-/// 64 rays on huis-c, dragon and conference-lit): 256 needed the fewest instructions of 32, 64, 128,
-/// 256, 512, 1024 and no limit.
-const GATHER_MAX: usize = 256;
-
-/// A blocker list key of a per-light query: a record's index, or a face-grid cell's index with the
-/// top bit set.
-const CELL_KEY: u32 = 1 << 31;
 
 impl LieVisibility<'_> {
     /// The blocker list of `key` with its chunk boxes.

@@ -19,6 +19,7 @@
 //! blocker tests and own-leaf tests (`plie render --stats`).
 
 mod light;
+mod whole;
 
 use super::bvh::{segment_occluded, Bvh};
 use super::leaf_voxels::LeafVoxels;
@@ -92,7 +93,7 @@ impl<'a> LieVisibility<'a> {
             own.push((start as u32, (own_tris.len() - start) as u32));
         }
         let own_boxes = ListBoxes::new(own.iter().copied(), &own_tris, &tri_boxes);
-        let (sat_start, sat) = if mode == Mode::Grid { light::grid_tables(plie) } else { (Vec::new(), Vec::new()) };
+        let (sat_start, sat) = if mode == Mode::Grid { whole::grid_tables(plie) } else { (Vec::new(), Vec::new()) };
         LieVisibility {
             scene,
             octree,

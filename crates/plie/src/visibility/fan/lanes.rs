@@ -1,0 +1,318 @@
+//! The fan's lane kernels (issue 21): per-ray values of a fan, the slab test of a box and the
+//! edge-function test of a triangle, eight lanes at a time with AVX2 and lane by lane otherwise. Each
+//! kernel computes exactly what its scalar form does, or only proves what the exact test would decide
+//! (see [`super`]).
+
+use glam::Vec3;
+
+use super::LANES;
+use crate::geometry::SEGMENT_EPS;
+
+/// The inverse of a direction's component for the slab test, with a non-finite one (of a zero or
+/// tiny component) replaced by `±f32::MAX`. A product with it is then never NaN, and the slab it gives
+/// is the whole line where the box's slab holds the origin and empty (up to the segment's tiny
+/// motion along that axis, which is far below the boxes' growth by the construction tolerance)
+/// where it does not, as [`crate::geometry::Segment`]'s parallel case decides.
+#[inline]
+pub(super) fn inverse(d: f32) -> f32 {
+    let i = 1.0 / d;
+    if i.is_finite() {
+        i
+    } else {
+        f32::MAX.copysign(i)
+    }
+}
+
+/// The per-ray values of [`Fan::set`] from the directions `[dx, dy, dz]`, eight rays at a time, as the
+/// scalar loop computes them (the same IEEE operations in the same order, so the same bits): into
+/// `[len, sz, ix, iy, iz]` and `kz`. Returns how many rays it did (a multiple of eight); the caller
+/// does the rest.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx,avx2")]
+pub(super) unsafe fn ray_lanes_avx(d: [&[f32]; 3], out: [&mut [f32]; 5], kz: &mut [u32]) -> usize {
+    use std::arch::x86_64::*;
+    let [dx, dy, dz] = d;
+    let [len, sz, ix, iy, iz] = out;
+    let n = [dx.len(), dy.len(), dz.len(), len.len(), sz.len(), ix.len(), iy.len(), iz.len(), kz.len()]
+        .into_iter()
+        .min()
+        .unwrap_or(0)
+        / LANES
+        * LANES;
+    let sign = _mm256_set1_ps(-0.0);
+    let (inf, max) = (_mm256_set1_ps(f32::INFINITY), _mm256_set1_ps(f32::MAX));
+    let one = _mm256_set1_ps(1.0);
+    let inverse = |v: __m256| {
+        let i = _mm256_div_ps(one, v);
+        let finite = _mm256_cmp_ps::<_CMP_LT_OQ>(_mm256_andnot_ps(sign, i), inf);
+        _mm256_blendv_ps(_mm256_or_ps(max, _mm256_and_ps(sign, i)), i, finite)
+    };
+    let mut k = 0;
+    while k < n {
+        // SAFETY: k + LANES <= n <= every array's length.
+        unsafe {
+            let (x, y, z) = (
+                _mm256_loadu_ps(dx.as_ptr().add(k)),
+                _mm256_loadu_ps(dy.as_ptr().add(k)),
+                _mm256_loadu_ps(dz.as_ptr().add(k)),
+            );
+            let dot = _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(x, x), _mm256_mul_ps(y, y)), _mm256_mul_ps(z, z));
+            _mm256_storeu_ps(len.as_mut_ptr().add(k), _mm256_sqrt_ps(dot));
+            _mm256_storeu_ps(ix.as_mut_ptr().add(k), inverse(x));
+            _mm256_storeu_ps(iy.as_mut_ptr().add(k), inverse(y));
+            _mm256_storeu_ps(iz.as_mut_ptr().add(k), inverse(z));
+            let (ax, ay, az) = (_mm256_andnot_ps(sign, x), _mm256_andnot_ps(sign, y), _mm256_andnot_ps(sign, z));
+            let c0 = _mm256_and_ps(_mm256_cmp_ps::<_CMP_GE_OQ>(ax, ay), _mm256_cmp_ps::<_CMP_GE_OQ>(ax, az));
+            let c1 = _mm256_cmp_ps::<_CMP_GE_OQ>(ay, az);
+            let dk = _mm256_blendv_ps(_mm256_blendv_ps(z, y, c1), x, c0);
+            _mm256_storeu_ps(sz.as_mut_ptr().add(k), _mm256_div_ps(one, dk));
+            let k12 = _mm256_blendv_ps(_mm256_set1_ps(2.0), one, c1);
+            let kk = _mm256_cvttps_epi32(_mm256_blendv_ps(k12, _mm256_setzero_ps(), c0));
+            _mm256_storeu_si256(kz.as_mut_ptr().add(k).cast(), kk);
+        }
+        k += LANES;
+    }
+    n
+}
+
+/// The active rays' inverse directions in lanes.
+pub(super) struct BoxLanes<'a> {
+    pub(super) ix: &'a [f32],
+    pub(super) iy: &'a [f32],
+    pub(super) iz: &'a [f32],
+}
+
+/// The bits of `within` (the word of lanes `base..base + 64`) whose segments (origin at the
+/// fan's apex, parameter range `[SEGMENT_EPS, 1 - SEGMENT_EPS]`) meet the box `[lo, hi]` given
+/// relative to the apex.
+#[inline]
+pub(super) fn meets_box(lo: Vec3, hi: Vec3, lanes: &BoxLanes, base: usize, within: u64) -> u64 {
+    #[cfg(target_arch = "x86_64")]
+    if std::arch::is_x86_feature_detected!("avx2") {
+        // SAFETY: AVX2 is available (checked above); the lane arrays are padded to whole blocks.
+        return unsafe { meets_box_avx(lo, hi, lanes, base, within) };
+    }
+    let mut out = 0;
+    let mut bits = within;
+    while bits != 0 {
+        let b = bits.trailing_zeros() as usize;
+        bits &= bits - 1;
+        let j = base + b;
+        let inv = Vec3::new(lanes.ix[j], lanes.iy[j], lanes.iz[j]);
+        let (a, c) = (lo * inv, hi * inv);
+        let t0 = a.min(c).max_element().max(SEGMENT_EPS);
+        let t1 = a.max(c).min_element().min(1.0 - SEGMENT_EPS);
+        if t0 <= t1 {
+            out |= 1 << b;
+        }
+    }
+    out
+}
+
+/// [`meets_box`], eight lanes at a time (blocks of lanes with no bit in `within` are skipped).
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx,avx2")]
+unsafe fn meets_box_avx(lo: Vec3, hi: Vec3, lanes: &BoxLanes, base: usize, within: u64) -> u64 {
+    use std::arch::x86_64::*;
+    let sp = |v: f32| _mm256_set1_ps(v);
+    let (lx, ly, lz, hx, hy, hz) = (sp(lo.x), sp(lo.y), sp(lo.z), sp(hi.x), sp(hi.y), sp(hi.z));
+    let (t_min, t_max) = (sp(SEGMENT_EPS), sp(1.0 - SEGMENT_EPS));
+    let n = lanes.ix.len().min(lanes.iy.len()).min(lanes.iz.len());
+    let mut out = 0u64;
+    let mut block = 0;
+    while block < 8 {
+        let byte = (within >> (block * 8)) & 0xff;
+        let j = base + block * LANES;
+        if byte != 0 && j + LANES <= n {
+            // SAFETY: j + LANES <= n <= every array's length.
+            let (ix, iy, iz) = unsafe {
+                (
+                    _mm256_loadu_ps(lanes.ix.as_ptr().add(j)),
+                    _mm256_loadu_ps(lanes.iy.as_ptr().add(j)),
+                    _mm256_loadu_ps(lanes.iz.as_ptr().add(j)),
+                )
+            };
+            let (ax, cx) = (_mm256_mul_ps(lx, ix), _mm256_mul_ps(hx, ix));
+            let (ay, cy) = (_mm256_mul_ps(ly, iy), _mm256_mul_ps(hy, iy));
+            let (az, cz) = (_mm256_mul_ps(lz, iz), _mm256_mul_ps(hz, iz));
+            let t0 = _mm256_max_ps(
+                _mm256_max_ps(_mm256_min_ps(ax, cx), _mm256_min_ps(ay, cy)),
+                _mm256_max_ps(_mm256_min_ps(az, cz), t_min),
+            );
+            let t1 = _mm256_min_ps(
+                _mm256_min_ps(_mm256_max_ps(ax, cx), _mm256_max_ps(ay, cy)),
+                _mm256_min_ps(_mm256_max_ps(az, cz), t_max),
+            );
+            let m = _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(t0, t1)) as u64;
+            out |= (m & byte) << (block * 8);
+        }
+        block += 1;
+    }
+    out
+}
+
+/// The active rays in lanes (see [`Fan`]).
+pub(super) struct Lanes<'a> {
+    pub(super) x: &'a [f32],
+    pub(super) y: &'a [f32],
+    pub(super) z: &'a [f32],
+    pub(super) len: &'a [f32],
+    pub(super) sz: &'a [f32],
+    pub(super) kz: &'a [u32],
+}
+
+/// Relative margin of the hit parameter's rounding: the watertight test's weighted mean of three
+/// products is within a few `ε` of the largest one's magnitude.
+const T_MARGIN: f32 = 1e-5;
+
+/// Sets bit `j` of `maybe` unless lane `j` is a sure miss of the triangle with scaled edge normals
+/// `s` (see [`Fan::test`]), or its hit parameter cannot fall in the segment's range (`span`: per
+/// axis, the least and greatest vertex coordinate, taken along the lane's `kz`).
+#[inline]
+pub(super) fn misses(s: &[Vec3; 3], span: &[(f32, f32); 3], lanes: &Lanes, maybe: &mut [u64]) {
+    #[cfg(target_arch = "x86_64")]
+    if std::arch::is_x86_feature_detected!("avx2") {
+        // SAFETY: AVX2 is available (checked above); the lane arrays are padded to whole blocks.
+        unsafe { misses_avx(s, span, lanes, maybe) };
+        return;
+    }
+    misses_scalar(s, span, lanes, maybe);
+}
+
+/// [`misses`], lane by lane.
+fn misses_scalar(s: &[Vec3; 3], span: &[(f32, f32); 3], lanes: &Lanes, maybe: &mut [u64]) {
+    maybe.fill(0);
+    for j in 0..lanes.x.len().min(maybe.len() * 64) {
+        let d = Vec3::new(lanes.x[j], lanes.y[j], lanes.z[j]);
+        let l = lanes.len[j];
+        let e = [s[0].dot(d), s[1].dot(d), s[2].dot(d)];
+        let pos = e.iter().any(|&e| e > l);
+        let neg = e.iter().any(|&e| e < -l);
+        let outside = {
+            let (lo, hi) = span[lanes.kz[j] as usize];
+            let (z1, z2) = (lo * lanes.sz[j], hi * lanes.sz[j]);
+            let (zlo, zhi) = (z1.min(z2), z1.max(z2));
+            let m = T_MARGIN * zlo.abs().max(zhi.abs());
+            zlo > 1.0 - SEGMENT_EPS + m || zhi < SEGMENT_EPS - m
+        };
+        if !(outside || pos && neg) {
+            maybe[j / 64] |= 1 << (j % 64);
+        }
+    }
+}
+
+/// [`misses`], eight lanes at a time.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx,avx2")]
+unsafe fn misses_avx(s: &[Vec3; 3], span: &[(f32, f32); 3], lanes: &Lanes, maybe: &mut [u64]) {
+    use std::arch::x86_64::*;
+    let n = lanes
+        .x
+        .len()
+        .min(lanes.y.len())
+        .min(lanes.z.len())
+        .min(lanes.len.len())
+        .min(lanes.sz.len())
+        .min(lanes.kz.len())
+        / LANES
+        * LANES;
+    let sp = |v: f32| _mm256_set1_ps(v);
+    let (s0x, s0y, s0z) = (sp(s[0].x), sp(s[0].y), sp(s[0].z));
+    let (s1x, s1y, s1z) = (sp(s[1].x), sp(s[1].y), sp(s[1].z));
+    let (s2x, s2y, s2z) = (sp(s[2].x), sp(s[2].y), sp(s[2].z));
+    let sign = sp(-0.0);
+    let (lo, hi) = (span.map(|s| sp(s.0)), span.map(|s| sp(s.1)));
+    let (one, two) = (_mm256_set1_epi32(1), _mm256_set1_epi32(2));
+    let (t_min, t_max, t_margin) = (sp(SEGMENT_EPS), sp(1.0 - SEGMENT_EPS), sp(T_MARGIN));
+    maybe.fill(0);
+    let mut j = 0;
+    while j < n && j / 64 < maybe.len() {
+        // SAFETY: j + LANES <= n <= every array's length.
+        let (x, y, z, l) = unsafe {
+            (
+                _mm256_loadu_ps(lanes.x.as_ptr().add(j)),
+                _mm256_loadu_ps(lanes.y.as_ptr().add(j)),
+                _mm256_loadu_ps(lanes.z.as_ptr().add(j)),
+                _mm256_loadu_ps(lanes.len.as_ptr().add(j)),
+            )
+        };
+        let nl = _mm256_xor_ps(l, sign);
+        let dot =
+            |sx, sy, sz| _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(sx, x), _mm256_mul_ps(sy, y)), _mm256_mul_ps(sz, z));
+        let (e0, e1, e2) = (dot(s0x, s0y, s0z), dot(s1x, s1y, s1z), dot(s2x, s2y, s2z));
+        let pos = _mm256_or_ps(
+            _mm256_or_ps(_mm256_cmp_ps::<_CMP_GT_OQ>(e0, l), _mm256_cmp_ps::<_CMP_GT_OQ>(e1, l)),
+            _mm256_cmp_ps::<_CMP_GT_OQ>(e2, l),
+        );
+        let neg = _mm256_or_ps(
+            _mm256_or_ps(_mm256_cmp_ps::<_CMP_LT_OQ>(e0, nl), _mm256_cmp_ps::<_CMP_LT_OQ>(e1, nl)),
+            _mm256_cmp_ps::<_CMP_LT_OQ>(e2, nl),
+        );
+        let mut miss = _mm256_and_ps(pos, neg);
+        {
+            // SAFETY: as above.
+            let (sz, kz) = unsafe {
+                (_mm256_loadu_ps(lanes.sz.as_ptr().add(j)), _mm256_loadu_si256(lanes.kz.as_ptr().add(j).cast()))
+            };
+            // The span along each lane's own axis.
+            let is1 = _mm256_castsi256_ps(_mm256_cmpeq_epi32(kz, one));
+            let is2 = _mm256_castsi256_ps(_mm256_cmpeq_epi32(kz, two));
+            let pick = |v: [__m256; 3]| _mm256_blendv_ps(_mm256_blendv_ps(v[0], v[1], is1), v[2], is2);
+            let (lo, hi) = (pick(lo), pick(hi));
+            let (z1, z2) = (_mm256_mul_ps(lo, sz), _mm256_mul_ps(hi, sz));
+            let (zlo, zhi) = (_mm256_min_ps(z1, z2), _mm256_max_ps(z1, z2));
+            let abs = |v| _mm256_andnot_ps(sign, v);
+            let m = _mm256_mul_ps(t_margin, _mm256_max_ps(abs(zlo), abs(zhi)));
+            let far = _mm256_cmp_ps::<_CMP_GT_OQ>(zlo, _mm256_add_ps(t_max, m));
+            let near = _mm256_cmp_ps::<_CMP_LT_OQ>(zhi, _mm256_sub_ps(t_min, m));
+            miss = _mm256_or_ps(miss, _mm256_or_ps(far, near));
+        }
+        let miss = _mm256_movemask_ps(miss) as u64;
+        maybe[j / 64] |= (!miss & 0xff) << (j % 64);
+        j += LANES;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The eight-lane ray values are the scalar loop's, bit for bit, on ordinary, tied, zero, signed
+    /// zero, tiny and huge components.
+    #[test]
+    fn ray_lanes_match_the_scalar_loop() {
+        #[cfg(target_arch = "x86_64")]
+        if std::arch::is_x86_feature_detected!("avx2") {
+            let special = [0.0, -0.0, 1.0, -1.0, 1e-30, -1e-38, 3e38, -2.5, 0.1, 7.0, -7.0, 1e-45];
+            let mut state = 11u64;
+            let mut rnd = || {
+                state = crate::render::sampler::mix64(state);
+                special[(state % special.len() as u64) as usize] * if state & 1 << 40 != 0 { 1.0 } else { 3.3 }
+            };
+            let n = 4096;
+            let (dx, dy, dz): (Vec<f32>, Vec<f32>, Vec<f32>) = (0..n).map(|_| (rnd(), rnd(), rnd())).collect();
+            let mut out: [Vec<f32>; 5] = std::array::from_fn(|_| vec![0.0; n]);
+            let mut kz = vec![0u32; n];
+            let [len, sz, ix, iy, iz] = &mut out;
+            // SAFETY: AVX2 is available (checked above).
+            let done = unsafe { ray_lanes_avx([&dx, &dy, &dz], [len, sz, ix, iy, iz], &mut kz) };
+            assert_eq!(done, n);
+            for k in 0..n {
+                let d = Vec3::new(dx[k], dy[k], dz[k]);
+                let a = d.abs();
+                let want_kz = if a.x >= a.y && a.x >= a.z {
+                    0
+                } else if a.y >= a.z {
+                    1
+                } else {
+                    2
+                };
+                let want = [d.length(), 1.0 / d[want_kz], inverse(d.x), inverse(d.y), inverse(d.z)];
+                for (w, (got, want)) in out.iter().map(|v| v[k]).zip(want).enumerate() {
+                    assert_eq!(got.to_bits(), want.to_bits(), "ray {k} {d}: value {w}: {got} against {want}");
+                }
+                assert_eq!(kz[k], want_kz as u32, "ray {k} {d}");
+            }
+        }
+    }
+}
