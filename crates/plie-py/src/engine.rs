@@ -8,15 +8,15 @@ use std::sync::OnceLock;
 use std::time::Instant;
 
 use glam::Vec3;
-use plie::{MaxBlockers, RefineParams};
 pub use plie::io::camera_path::CameraPath;
 use plie::octree::{Octree, OctreeParams};
 use plie::visibility::bvh::Bvh;
 use plie::visibility::{Brute, BvhVisibility, NoVisibility, OctreeVisibility, QueryCtx, QueryStats, ShadowRay};
-use plie::Visibility;
 pub use plie::Camera;
+use plie::Visibility;
 use plie::{Environment, Grids, Integrator, Mode, Nee, PathSettings, PlieParams, Propagation, Regions};
 use plie::{LightId, Scene, TriId};
+use plie::{MaxBlockers, RefineParams};
 use plie::{RenderSettings, Renderer};
 use rayon::prelude::*;
 
@@ -75,7 +75,9 @@ impl LoadedScene {
             Mode::Octree => Box::new(OctreeVisibility::new(s, self.octree()?)),
             Mode::Bvh => Box::new(BvhVisibility::new(s, self.bvh())),
             Mode::None => Box::new(NoVisibility),
-            m => return Err(invalid(format!("mode {m} answers from a P-LIE: build or load an Environment and pass it"))),
+            m => {
+                return Err(invalid(format!("mode {m} answers from a P-LIE: build or load an Environment and pass it")))
+            }
         })
     }
 }
