@@ -122,6 +122,12 @@ impl Answers {
         *self.get_mut(a) += 1;
     }
 
+    /// Counts `n` rays on path `a`.
+    #[inline]
+    pub fn count_n(&mut self, a: Answer, n: usize) {
+        *self.get_mut(a) += n as u64;
+    }
+
     /// Rays counted on any path.
     pub fn total(self) -> u64 {
         Answer::ALL.iter().map(|&a| self.get(a)).sum()

@@ -53,6 +53,11 @@ pub struct Fan {
     all: [Vec<f32>; 8],
     /// Per ray: the watertight test's axis `kz` (the largest component of `d`).
     all_kz: Vec<u32>,
+    /// Rays in the fan (the arrays `all` and `all_kz` are padded with zeros to whole lanes).
+    n: usize,
+    /// True while every ray is active ([`Fan::select_all`]): the edge test's lanes are then `all`'s
+    /// own arrays.
+    whole: bool,
     /// The exact tests, built on first use: valid where bit `k` of `built` is set.
     tests: Vec<RayTest>,
     built: Vec<u64>,
@@ -127,6 +132,14 @@ impl Fan {
             kzs[k] = kz as u32;
             sz[k] = 1.0 / d[kz];
         }
+        // The padding lanes: zero (a zero direction meets no box and no triangle's cone).
+        let padded = n.div_ceil(LANES) * LANES;
+        for v in &mut self.all {
+            v.resize(padded, 0.0);
+        }
+        self.all_kz.resize(padded, 0);
+        self.n = n;
+        self.whole = false;
         if self.tests.len() < n {
             self.tests.resize(n, RayTest::new(Vec3::ZERO, Vec3::X, 0.0, 1.0));
         }
@@ -135,9 +148,21 @@ impl Fan {
         self.live = 0;
     }
 
+    /// Makes every ray active, copying only the lanes of box tests (the edge test reads `all`).
+    pub fn select_all(&mut self) {
+        for (lanes, from) in [&mut self.aix, &mut self.aiy, &mut self.aiz].into_iter().zip(&self.all[5..]) {
+            lanes.clear();
+            lanes.extend_from_slice(from);
+        }
+        self.idx.clear();
+        self.idx.extend(0..self.n as u32);
+        self.whole = true;
+        self.reopen();
+    }
+
     /// Makes the rays `k` with `want(k)` the active ones.
     pub fn select(&mut self, want: impl Fn(usize) -> bool) {
-        let n = self.all_kz.len();
+        let n = self.n;
         self.idx.clear();
         self.idx.extend((0..n as u32).filter(|&k| want(k as usize)));
         let m = self.idx.len();
@@ -155,7 +180,7 @@ impl Fan {
         for (lanes, from) in active.into_iter().zip(&self.all) {
             lanes.resize(padded, 0.0);
             if m == n {
-                lanes[..m].copy_from_slice(from);
+                lanes[..m].copy_from_slice(&from[..m]);
             } else {
                 for (l, &k) in lanes.iter_mut().zip(&self.idx) {
                     *l = from[k as usize];
@@ -169,6 +194,13 @@ impl Fan {
             *l = self.all_kz[k as usize];
         }
         self.akz[m..].fill(0);
+        self.whole = false;
+        self.reopen();
+    }
+
+    /// Opens every active ray and clears the masks.
+    fn reopen(&mut self) {
+        let m = self.idx.len();
         let words = m.div_ceil(64);
         self.open.clear();
         self.open.resize(words, u64::MAX);
@@ -292,7 +324,12 @@ impl Fan {
         // coordinate.
         let span = [0, 1, 2].map(|k| (a[k].min(b[k]).min(c[k]), a[k].max(b[k]).max(c[k])));
         if s.iter().all(|v| v.is_finite()) {
-            let lanes = Lanes { x: &self.ax, y: &self.ay, z: &self.az, len: &self.al, sz: &self.asz, kz: &self.akz };
+            let lanes = if self.whole {
+                let [x, y, z, len, sz, ..] = &self.all;
+                Lanes { x, y, z, len, sz, kz: &self.all_kz }
+            } else {
+                Lanes { x: &self.ax, y: &self.ay, z: &self.az, len: &self.al, sz: &self.asz, kz: &self.akz }
+            };
             misses(&s, &span, &lanes, &mut self.maybe);
         } else {
             self.maybe.fill(u64::MAX);

@@ -28,29 +28,26 @@ impl LieVisibility<'_> {
         let lanes_before = ctx.stats.lane_tests;
         sc.fan.set(rays);
         sc.fan.pyramid.set(rays.origin, &self.scene.lights[rays.light.idx()], self.pad * 10.0);
-        sc.fan.select(|_| true);
+        sc.fan.select_all();
         ctx.begin_query();
         let before = ctx.stats.triangle_tests;
         for &key in &sc.lists {
             self.fan_list(rays, self.list_of(key), true, &mut sc.fan, out, ctx);
         }
         ctx.stats.blocker_tests += ctx.stats.triangle_tests - before;
-        sc.path.clear();
-        sc.path.extend(out.iter().map(|&o| if o { path::LIST_HIT } else { path::LIST }));
-        sc.fan.select(|k| !out[k]);
+        let list_hits = out.iter().filter(|&&o| o).count();
+        // Every ray stays active: those the lists hit are closed already, so the leaf's own
+        // triangles are tested against the others only.
         let before = ctx.stats.triangle_tests;
         let (start, len) = self.own[leaf.idx()];
         let own = self.own_boxes.of(leaf.idx(), &self.own_tris[start as usize..(start + len) as usize]);
         self.fan_list(rays, own, false, &mut sc.fan, out, ctx);
         ctx.stats.own_leaf_tests += ctx.stats.triangle_tests - before;
-        for (k, &o) in out.iter().enumerate() {
-            let a = match (sc.path[k], o) {
-                (path::LIST_HIT, _) => Answer::BlockersHit,
-                (_, true) => Answer::OwnLeaf,
-                _ => Answer::BlockersMiss,
-            };
-            ctx.stats.answered(a, o);
-        }
+        let hits = out.iter().filter(|&&o| o).count();
+        let answers = &mut ctx.stats.answers;
+        answers.count_n(Answer::BlockersHit, list_hits);
+        answers.count_n(Answer::OwnLeaf, hits - list_hits);
+        answers.count_n(Answer::BlockersMiss, out.len() - hits);
         if ctx.stats.lane_tests == lanes_before {
             ctx.stats.lights.whole_lit += 1;
         } else {
@@ -85,9 +82,7 @@ impl LieVisibility<'_> {
                 out.fill(true);
                 ctx.stats.lights.queries += 1;
                 ctx.stats.lights.whole_umbra += 1;
-                for _ in 0..n {
-                    ctx.stats.answered(Answer::Umbra, true);
-                }
+                ctx.stats.answers.count_n(Answer::Umbra, n);
                 ctx.light = scratch;
                 return;
             }
@@ -298,13 +293,13 @@ impl LieVisibility<'_> {
         let lanes_before = ctx.stats.lane_tests;
         if self.any_in_pyramid(rays, own, &sc.fan.pyramid, ctx) {
             sc.fan.set(rays);
-            sc.fan.select(|_| true);
+            sc.fan.select_all();
             self.fan_list(rays, own, false, &mut sc.fan, out, ctx);
         }
         ctx.stats.own_leaf_tests += ctx.stats.triangle_tests - before;
-        for &o in out.iter() {
-            ctx.stats.answered(if o { Answer::OwnLeaf } else { Answer::Lit }, o);
-        }
+        let hits = out.iter().filter(|&&o| o).count();
+        ctx.stats.answers.count_n(Answer::OwnLeaf, hits);
+        ctx.stats.answers.count_n(Answer::Lit, out.len() - hits);
         if ctx.stats.lane_tests == lanes_before {
             ctx.stats.lights.whole_lit += 1;
         } else {
