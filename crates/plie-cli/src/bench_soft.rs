@@ -101,13 +101,16 @@ impl Visibility for PerRay<'_> {
     }
 }
 
-/// The default scenes: the ten built-in ones, then the shared ones found in `shared`.
+/// The default scenes: the ten built-in ones, then the shared ones found in `shared`. Each shared
+/// scene not found is named on stderr (even with `--quiet`: the table is then not the documented one).
 pub fn default_scenes(shared: &Path) -> Vec<String> {
     let mut s: Vec<String> = builtin::NAMES.iter().map(|n| n.to_string()).collect();
     for (f, ..) in SHARED {
         let p = shared.join(f);
         if p.exists() {
             s.push(p.display().to_string());
+        } else {
+            eprintln!("notice: {} not found: the soft-shadow table leaves it out (see --shared)", p.display());
         }
     }
     s
