@@ -100,7 +100,6 @@ impl LieVisibility<'_> {
         }
         sc.lists.clear();
         sc.ranges.clear();
-        sc.fan.set(rays);
         sc.path.clear();
         sc.path.resize(n, path::LIT);
         sc.list.clear();
@@ -189,6 +188,7 @@ impl LieVisibility<'_> {
         } else {
             let lanes_before = ctx.stats.lane_tests;
             let margin = self.pad * 10.0;
+            sc.fan.set(rays);
             sc.fan.pyramid.set(x, &self.scene.lights[rays.light.idx()], margin);
             // Short lists: their triangles, each once, against every ray that has a short list (a
             // ray tested against another ray's blockers too can only find true blockers). Long lists
