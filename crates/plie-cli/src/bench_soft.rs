@@ -276,8 +276,8 @@ pub fn report(r: &SoftResults) -> String {
         }
         let _ = writeln!(s);
         // Whole answers of the P-LIE modes.
-        let _ = writeln!(s, "(point, light) pairs answered whole (umbra / lit), by the lists gathered under the light's footprints, or per sample, `grid`:\n");
-        let _ = writeln!(s, "| scene | pairs | whole umbra | whole lit | gathered | per sample |");
+        let _ = writeln!(s, "(point, light) pairs answered whole (umbra / lit), by the short lists gathered under the light's footprints, or by the scene BVH, `grid`:\n");
+        let _ = writeln!(s, "| scene | pairs | whole umbra | whole lit | gathered | scene BVH |");
         let _ = writeln!(s, "|---|---|---|---|---|---|");
         for sc in &scenes {
             if let Some(row) = r.rows.iter().find(|x| x.scene == *sc && x.mode == "grid" && x.shadow_rays == n) {
@@ -290,7 +290,7 @@ pub fn report(r: &SoftResults) -> String {
                     pct(l.whole_umbra),
                     pct(l.whole_lit),
                     pct(l.gathered),
-                    pct(l.per_sample)
+                    pct(l.scene)
                 );
             }
         }

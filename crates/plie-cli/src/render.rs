@@ -311,7 +311,7 @@ fn print_answers(s: &QueryStats) {
             ("whole umbra", l.whole_umbra),
             ("whole lit", l.whole_lit),
             ("gathered", l.gathered),
-            ("per sample", l.per_sample),
+            ("scene BVH", l.scene),
         ] {
             eprintln!("  {name:<14} {n:>12} {:>6.1}%", share(n));
         }

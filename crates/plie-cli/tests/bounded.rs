@@ -122,9 +122,10 @@ fn ctrl_c_stops_a_build_and_leaves_no_file() {
     use std::process::{Command, Stdio};
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("b.plie");
-    // The full stress scene takes far longer than the signal's delay (26 s in a release build).
+    // A stress scene four times the default takes far longer than the signal's delay (19 s on one
+    // thread in a release build; the default one, 1.5 s, could finish first).
     let child = Command::new(env!("CARGO_BIN_EXE_plie"))
-        .args(["build", "--scene", "balusters", "--threads", "1", "-o"])
+        .args(["build", "--scene", "balusters-128", "--threads", "1", "-o"])
         .arg(&out)
         .stdout(Stdio::null())
         .stderr(Stdio::piped())

@@ -47,8 +47,9 @@ fn queries(scene: &Scene, built: &Built, n: usize, seed: u64) -> Vec<Query> {
     out
 }
 
-/// Checks every exact mode's per-light answers against its per-ray answers and against brute force.
-fn check(scene: &Scene, built: &Built, qs: &[Query]) {
+/// Checks every exact mode's per-light answers against its per-ray answers and against brute force;
+/// returns the counters of the queries.
+fn check(scene: &Scene, built: &Built, qs: &[Query]) -> plie::visibility::QueryStats {
     let brute = built.vis(scene, Mode::Brute);
     let mut ctx = QueryCtx::new(scene.triangles.len());
     let reference: Vec<Vec<bool>> =
@@ -83,6 +84,7 @@ fn check(scene: &Scene, built: &Built, qs: &[Query]) {
             }
         }
     }
+    ctx.stats
 }
 
 #[test]
@@ -101,6 +103,22 @@ fn per_light_answers_equal_per_ray_and_brute_force_on_shared_scenes() {
         // Brute force over 100k triangles is slow: fewer queries on the large scenes.
         let n = if scene.triangles.len() > 10_000 { 40 } else { 300 };
         check(&scene, &built, &queries(&scene, &built, n, 22));
+    }
+}
+
+/// With face grids and a small blocker cap, many lights are answered through the gathered lists
+/// and many rays through records that store no list (the scene BVH): still as per ray and as brute
+/// force.
+#[test]
+fn per_light_answers_with_grids_and_a_small_blocker_cap() {
+    for name in ["cornell-cube-2", "huis-c", "dragon"] {
+        let scene = plie::scene::builtin::load(name).unwrap();
+        for cap in [None, Some(16)] {
+            let built = Built::new(&scene, PlieParams { blocker_cap: cap, ..PlieParams::default() });
+            let stats = check(&scene, &built, &queries(&scene, &built, 200, 24));
+            let l = stats.lights;
+            assert!(l.gathered > 0 && l.scene > 0, "{name} {cap:?}: both ways taken: {l:?}");
+        }
     }
 }
 

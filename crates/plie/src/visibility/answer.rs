@@ -26,9 +26,10 @@ pub enum Answer {
     InsideLeaf,
     /// The start point lies in no leaf: answered by walking the octree (mode a), either way.
     OutsideOctree,
-    /// The segment leaves its leaf through a face whose record stores no list
-    /// ([`crate::lie::RecordKind::Scene`]: more blockers than the cap, or over the memory budget), and
-    /// not inside its umbra: the whole segment answered by the scene BVH, either way.
+    /// The whole segment answered by the scene BVH, either way: it leaves its leaf through a face
+    /// whose record stores no list ([`crate::lie::RecordKind::Scene`]: more blockers than the cap,
+    /// or over the memory budget), and not inside its umbra; or, in the per-light query, its light's
+    /// footprints were neither all umbra, all lit, nor over short lists only.
     SceneBvh,
 }
 

@@ -122,12 +122,6 @@ impl Chunked<'_> {
     /// The empty list.
     pub const EMPTY: Chunked<'static> = Chunked { list: &[], boxes: &[] };
 
-    /// True if the list has a hierarchy.
-    #[inline]
-    pub fn is_long(&self) -> bool {
-        !self.boxes.is_empty()
-    }
-
     /// Walks the hierarchy from the top (whose box is not tested: it holds the whole list), going
     /// into the boxes `v` enters and visiting their chunks in list order; returns true if `v`
     /// stopped the walk.

@@ -49,6 +49,10 @@ pub(crate) fn wall_scene() -> (crate::Scene, crate::TriId) {
     (b.build().expect("valid scene"), floor)
 }
 
+/// Fewer samples of a light than this are asked ray by ray by the per-light queries: with so few,
+/// sharing work does not pay (measured at 4 samples per light, `plie bench --soft-shadows`).
+pub(crate) const FAN_MIN: usize = 8;
+
 /// A visibility method: answers shadow-ray queries exactly (but for the reference modes that say
 /// otherwise: [`Mode::None`] and native Embree, [`Mode::is_exact`]).
 pub trait Visibility: Sync {

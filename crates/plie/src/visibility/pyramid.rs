@@ -91,6 +91,21 @@ impl Pyramid {
         n.dot(tri.v[0]) - off < -m && n.dot(tri.v[1]) - off < -m && n.dot(tri.v[2]) - off < -m
     }
 
+    /// True if no segment of the pyramid can meet anything in the box `[lo, hi]`, given relative to
+    /// the apex. Only the side planes are tested.
+    #[inline]
+    pub fn culls_rel(&self, lo: Vec3, hi: Vec3) -> bool {
+        let m = self.margin;
+        if let Some([sx, sy, sz]) = self.lanes {
+            // The box corner farthest along each normal, four normals at once.
+            let far =
+                |s: Vec4, lo: f32, hi: f32| Vec4::select(s.cmpge(Vec4::ZERO), Vec4::splat(hi), Vec4::splat(lo)) * s;
+            let d = far(sx, lo.x, hi.x) + far(sy, lo.y, hi.y) + far(sz, lo.z, hi.z);
+            return d.cmplt(Vec4::splat(-m)).any();
+        }
+        self.sides.iter().any(|s| s.dot(Vec3::select(s.cmpge(Vec3::ZERO), hi, lo)) < -m)
+    }
+
     /// True if no segment of the pyramid can meet anything in the box `b`.
     #[inline]
     pub fn culls_box(&self, b: &Aabb) -> bool {

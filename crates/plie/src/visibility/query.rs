@@ -103,11 +103,12 @@ pub struct LightAnswers {
     /// Pairs whose every ray was answered without a triangle test, some of them lit (no blocker in
     /// their cell and no triangle of the leaf in the pyramid to the light).
     pub whole_lit: u64,
-    /// Pairs whose rays were all tested against the lists of every cell under the light's
-    /// footprints, without finding each ray's own cell.
+    /// Pairs whose rays were all tested against the short lists of every cell under the light's
+    /// footprints (without finding each ray's own cell) and the leaf's own triangles.
     pub gathered: u64,
-    /// Pairs whose rays each found their own cell or list, then tested candidate triangles.
-    pub per_sample: u64,
+    /// Pairs answered by the scene BVH, all rays at once: their footprints cover cells of different
+    /// kinds, long lists, or records that store no list.
+    pub scene: u64,
 }
 
 impl std::ops::AddAssign for LightAnswers {
@@ -116,7 +117,7 @@ impl std::ops::AddAssign for LightAnswers {
         self.whole_umbra += o.whole_umbra;
         self.whole_lit += o.whole_lit;
         self.gathered += o.gathered;
-        self.per_sample += o.per_sample;
+        self.scene += o.scene;
     }
 }
 

@@ -30,13 +30,14 @@ use obvhs::ploc::PlocBuilder;
 use obvhs::ray::Ray;
 use obvhs::BvhBuildParams;
 
-use super::{blocks, QueryCtx, ShadowRay, Visibility};
+use super::{blocks, LightRays, QueryCtx, ShadowRay, Visibility};
 use crate::geometry::RayTest;
 use crate::scene::{Scene, TriId};
 pub use crowd::CROWD_LIMIT;
 use crowd::{group_crowded_centres, Groups, Prims, Single};
 
 mod crowd;
+mod fan_walk;
 
 /// Size of the scene in the BVH's normalised space.
 const NORMALISED_SIZE: f32 = 1000.0;
@@ -204,6 +205,27 @@ impl<'a> BvhVisibility<'a> {
 impl Visibility for BvhVisibility<'_> {
     fn occluded(&self, ray: &ShadowRay, ctx: &mut QueryCtx) -> bool {
         segment_occluded(self.scene, self.bvh, ray, ctx)
+    }
+
+    /// All samples of the light down the BVH at once ([`Bvh::fan_occluded`]), as a packet; a few
+    /// samples ray by ray.
+    fn occluded_light(&self, rays: &LightRays, out: &mut [bool], ctx: &mut QueryCtx) {
+        if rays.targets.len() < crate::visibility::FAN_MIN {
+            for (k, o) in out.iter_mut().enumerate() {
+                *o = self.occluded(&rays.ray(k), ctx);
+            }
+            return;
+        }
+        let mut sc = std::mem::take(&mut ctx.light);
+        out.fill(false);
+        sc.fan.set(rays);
+        sc.fan.pyramid.set(
+            rays.origin,
+            &self.scene.lights[rays.light.idx()],
+            self.scene.scale() * crate::geometry::TOLERANCE_REL * 10.0,
+        );
+        self.bvh.fan_occluded(self.scene, rays, &mut sc.fan, &mut sc.walk, out, ctx);
+        ctx.light = sc;
     }
 }
 

@@ -75,7 +75,7 @@ pub(super) unsafe fn ray_lanes_avx(d: [&[f32]; 3], out: [&mut [f32]; 5], kz: &mu
     n
 }
 
-/// The active rays' inverse directions in lanes.
+/// The rays' inverse directions in lanes.
 pub(super) struct BoxLanes<'a> {
     pub(super) ix: &'a [f32],
     pub(super) iy: &'a [f32],
@@ -151,7 +151,7 @@ unsafe fn meets_box_avx(lo: Vec3, hi: Vec3, lanes: &BoxLanes, base: usize, withi
     out
 }
 
-/// The active rays in lanes (see [`Fan`]).
+/// The rays in lanes (see [`Fan`]).
 pub(super) struct Lanes<'a> {
     pub(super) x: &'a [f32],
     pub(super) y: &'a [f32],

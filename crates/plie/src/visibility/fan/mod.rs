@@ -19,7 +19,7 @@
 use glam::Vec3;
 
 use super::{LightRays, QueryCtx};
-use crate::geometry::{Aabb, RayTest, Triangle};
+use crate::geometry::{RayTest, Triangle};
 use crate::scene::{Scene, TriId};
 
 pub use super::pyramid::Pyramid;
@@ -41,48 +41,25 @@ pub const EDGE_MARGIN: f32 = 256.0 * f32::EPSILON;
 /// Lanes of the fast test.
 const LANES: usize = 8;
 
-/// Per-thread scratch of a fan: the directions `d_k = y_k - x`, their lengths, the lazily built
-/// exact ray tests, and the *active* rays (those the current candidates are tested against) copied
-/// into lanes.
+/// Per-thread scratch of a fan: the directions `d_k = y_k - x` in lanes, their lengths, the lazily
+/// built exact ray tests, and which rays are still open.
 #[derive(Clone, Debug, Default)]
 pub struct Fan {
     origin: Vec3,
-    /// Per ray, in the order of the active lanes' arrays (`ax` ... `aiz`): its direction `d = y - x`,
-    /// its length, the watertight test's `1 / d[kz]` and the inverse direction for box tests
-    /// ([`inverse`]).
+    /// Per ray, in lanes: its direction `d = y - x`, its length, the watertight test's `1 / d[kz]`
+    /// and the inverse direction for box tests ([`inverse`]); padded with zeros to whole lanes (a
+    /// zero direction meets no box and no triangle's cone).
     all: [Vec<f32>; 8],
     /// Per ray: the watertight test's axis `kz` (the largest component of `d`).
     all_kz: Vec<u32>,
-    /// Rays in the fan (the arrays `all` and `all_kz` are padded with zeros to whole lanes).
-    n: usize,
-    /// True while every ray is active ([`Fan::select_all`]): the edge test's lanes are then `all`'s
-    /// own arrays.
-    whole: bool,
     /// The exact tests, built on first use: valid where bit `k` of `built` is set.
     tests: Vec<RayTest>,
     built: Vec<u64>,
-    /// Active rays: their indices, and their directions and lengths in lanes (padded with zeros to a
-    /// multiple of [`LANES`]).
-    idx: Vec<u32>,
-    ax: Vec<f32>,
-    ay: Vec<f32>,
-    az: Vec<f32>,
-    al: Vec<f32>,
-    /// Per active lane: the watertight test's `1 / d[kz]`, and its axis `kz`.
-    asz: Vec<f32>,
-    akz: Vec<u32>,
-    /// Per active lane: the inverse direction for box tests ([`inverse`]).
-    aix: Vec<f32>,
-    aiy: Vec<f32>,
-    aiz: Vec<f32>,
-    /// The lane masks of a walk down a box hierarchy ([`Fan::narrow`]): [`WALK_LEVELS`] masks of
-    /// `open.len()` words each.
-    masks: Vec<u64>,
-    /// Bit `j` of word `j / 64`: active lane `j` is still open (not found occluded).
+    /// Bit `k` of word `k / 64`: ray `k` is still open (not found occluded).
     open: Vec<u64>,
-    /// Bit per active lane: the fast test could not prove a miss for the current triangle.
+    /// Bit per ray: the fast test could not prove a miss for the current triangle.
     maybe: Vec<u64>,
-    /// Active rays still open.
+    /// Rays still open.
     live: usize,
     /// The pyramid of the current light.
     pub pyramid: Pyramid,
@@ -138,133 +115,24 @@ impl Fan {
             v.resize(padded, 0.0);
         }
         self.all_kz.resize(padded, 0);
-        self.n = n;
-        self.whole = false;
         if self.tests.len() < n {
             self.tests.resize(n, RayTest::new(Vec3::ZERO, Vec3::X, 0.0, 1.0));
         }
         self.built.clear();
         self.built.resize(n.div_ceil(64), 0);
-        self.live = 0;
-    }
-
-    /// Makes every ray active, copying only the lanes of box tests (the edge test reads `all`).
-    pub fn select_all(&mut self) {
-        for (lanes, from) in [&mut self.aix, &mut self.aiy, &mut self.aiz].into_iter().zip(&self.all[5..]) {
-            lanes.clear();
-            lanes.extend_from_slice(from);
-        }
-        self.idx.clear();
-        self.idx.extend(0..self.n as u32);
-        self.whole = true;
-        self.reopen();
-    }
-
-    /// Makes the rays `k` with `want(k)` the active ones.
-    pub fn select(&mut self, want: impl Fn(usize) -> bool) {
-        let n = self.n;
-        self.idx.clear();
-        self.idx.extend((0..n as u32).filter(|&k| want(k as usize)));
-        let m = self.idx.len();
-        let padded = m.div_ceil(LANES) * LANES;
-        let active = [
-            &mut self.ax,
-            &mut self.ay,
-            &mut self.az,
-            &mut self.al,
-            &mut self.asz,
-            &mut self.aix,
-            &mut self.aiy,
-            &mut self.aiz,
-        ];
-        for (lanes, from) in active.into_iter().zip(&self.all) {
-            lanes.resize(padded, 0.0);
-            if m == n {
-                lanes[..m].copy_from_slice(&from[..m]);
-            } else {
-                for (l, &k) in lanes.iter_mut().zip(&self.idx) {
-                    *l = from[k as usize];
-                }
-            }
-            // The padding lanes: zero (a zero direction meets no box and no triangle's cone).
-            lanes[m..].fill(0.0);
-        }
-        self.akz.resize(padded, 0);
-        for (l, &k) in self.akz.iter_mut().zip(&self.idx) {
-            *l = self.all_kz[k as usize];
-        }
-        self.akz[m..].fill(0);
-        self.whole = false;
-        self.reopen();
-    }
-
-    /// Opens every active ray and clears the masks.
-    fn reopen(&mut self) {
-        let m = self.idx.len();
-        let words = m.div_ceil(64);
+        // Every ray open.
+        let words = n.div_ceil(64);
         self.open.clear();
         self.open.resize(words, u64::MAX);
-        if m % 64 != 0 {
-            self.open[words - 1] = (1u64 << (m % 64)) - 1;
+        if n % 64 != 0 {
+            self.open[words - 1] = (1u64 << (n % 64)) - 1;
         }
         self.maybe.clear();
         self.maybe.resize(words, 0);
-        self.masks.clear();
-        self.masks.resize(words * WALK_LEVELS, 0);
-        self.live = m;
+        self.live = n;
     }
 
-    /// One step down a box hierarchy walked by all active rays at once: mask `level` becomes the
-    /// open lanes of mask `level - 1` (of all open lanes, for level 0) whose segments meet the box
-    /// `b`. Returns whether any does. The test is the slab test of [`crate::geometry::Segment::clip`],
-    /// eight lanes at a time; it never drops a lane whose segment meets `b`. Counts a box test per
-    /// lane tested.
-    #[inline]
-    pub fn narrow(&mut self, b: &Aabb, level: usize, ctx: &mut QueryCtx) -> bool {
-        let w = self.open.len();
-        let (above, rest) = self.masks.split_at_mut(level * w);
-        let from = if level == 0 { &self.open[..] } else { &above[(level - 1) * w..] };
-        let to = &mut rest[..w];
-        let lanes = BoxLanes { ix: &self.aix, iy: &self.aiy, iz: &self.aiz };
-        let (lo, hi) = (b.min - self.origin, b.max - self.origin);
-        let mut any = 0;
-        for i in 0..w {
-            let f = from[i] & self.open[i];
-            ctx.stats.box_tests += u64::from(f.count_ones());
-            to[i] = if f == 0 { 0 } else { meets_box(lo, hi, &lanes, i * 64, f) };
-            any |= to[i];
-        }
-        any != 0
-    }
-
-    /// Mask `level` becomes all open lanes (for a hierarchy whose top box is not worth testing).
-    #[inline]
-    pub fn narrow_to_open(&mut self, level: usize) {
-        let w = self.open.len();
-        self.masks[level * w..(level + 1) * w].copy_from_slice(&self.open);
-    }
-
-    /// The watertight test of triangle `t` for each open lane of mask `level`: each ray it blocks
-    /// gets `out[k]` set and is closed. The caller has excluded the rays' own triangles.
-    #[inline]
-    pub fn test_level(
-        &mut self,
-        scene: &Scene,
-        rays: &LightRays,
-        t: TriId,
-        level: usize,
-        out: &mut [bool],
-        ctx: &mut QueryCtx,
-    ) {
-        let w = self.open.len();
-        let tri = &scene.triangles[t.idx()];
-        for i in 0..w {
-            let bits = self.masks[level * w + i] & self.open[i];
-            self.exact(tri, i, bits, rays, out, ctx);
-        }
-    }
-
-    /// The watertight test of `tri` for the active lanes `bits` of word `w`: each ray it blocks gets
+    /// The watertight test of `tri` for the rays `bits` of word `w`: each ray it blocks gets
     /// `out[k]` set and is closed.
     #[inline]
     fn exact(
@@ -277,19 +145,76 @@ impl Fan {
         ctx: &mut QueryCtx,
     ) {
         while bits != 0 {
-            let j = w * 64 + bits.trailing_zeros() as usize;
+            let k = w * 64 + bits.trailing_zeros() as usize;
             bits &= bits - 1;
-            let k = self.idx[j] as usize;
             if self.built[k / 64] & (1 << (k % 64)) == 0 {
                 self.tests[k] = rays.ray(k).test;
                 self.built[k / 64] |= 1 << (k % 64);
             }
             ctx.stats.triangle_tests += 1;
             if self.tests[k].hit(tri).is_some() {
-                self.open[w] &= !(1u64 << (j % 64));
+                self.open[w] &= !(1u64 << (k % 64));
                 self.live -= 1;
                 out[k] = true;
             }
+        }
+    }
+
+    /// Words of a mask over the rays (64 rays per word).
+    #[inline]
+    pub fn words(&self) -> usize {
+        self.open.len()
+    }
+
+    /// The open rays, one bit each.
+    #[inline]
+    pub fn open(&self) -> &[u64] {
+        &self.open
+    }
+
+    /// The fan's apex `x`.
+    #[inline]
+    pub fn origin(&self) -> Vec3 {
+        self.origin
+    }
+
+    /// `to` becomes the open lanes of `within` whose segments meet the box `[lo, hi]` (given
+    /// relative to the apex), by the slab test of [`Fan::narrow`]. Returns whether any does.
+    #[inline]
+    pub fn meets(&self, lo: Vec3, hi: Vec3, within: &[u64], to: &mut [u64], ctx: &mut QueryCtx) -> bool {
+        let [.., ix, iy, iz] = &self.all;
+        let lanes = BoxLanes { ix, iy, iz };
+        let mut any = 0;
+        for (i, (t, &w)) in to.iter_mut().zip(within).enumerate() {
+            let f = w & self.open[i];
+            ctx.stats.box_tests += u64::from(f.count_ones());
+            *t = if f == 0 { 0 } else { meets_box(lo, hi, &lanes, i * 64, f) };
+            any |= *t;
+        }
+        any != 0
+    }
+
+    /// [`Fan::test`] for the open lanes of `within` only: a few lanes go straight to the watertight
+    /// test, more first through the eight-lane edge test.
+    #[inline]
+    pub fn test_within(
+        &mut self,
+        scene: &Scene,
+        rays: &LightRays,
+        t: TriId,
+        within: &[u64],
+        out: &mut [bool],
+        ctx: &mut QueryCtx,
+    ) {
+        let few = within.iter().zip(&self.open).map(|(w, o)| (w & o).count_ones()).sum::<u32>() <= DIRECT_MAX;
+        if few {
+            let tri = &scene.triangles[t.idx()];
+            for w in 0..self.open.len() {
+                let bits = within[w] & self.open[w];
+                self.exact(tri, w, bits, rays, out, ctx);
+            }
+        } else {
+            self.test_masked(scene, rays, t, Some(within), out, ctx);
         }
     }
 
@@ -299,11 +224,25 @@ impl Fan {
         self.live
     }
 
-    /// Tests triangle `t` against the open active rays: each ray `k` it blocks gets `out[k]` set and
+    /// Tests triangle `t` against the open rays: each ray `k` it blocks gets `out[k]` set and
     /// is closed. Counts a lane test per open ray, and a triangle test per watertight test. The caller has excluded the rays' own
     /// triangles (the origin's and the light's).
     #[inline]
     pub fn test(&mut self, scene: &Scene, rays: &LightRays, t: TriId, out: &mut [bool], ctx: &mut QueryCtx) {
+        self.test_masked(scene, rays, t, None, out, ctx);
+    }
+
+    /// [`Fan::test`], for the open lanes of `within` only when given.
+    #[inline(always)]
+    fn test_masked(
+        &mut self,
+        scene: &Scene,
+        rays: &LightRays,
+        t: TriId,
+        within: Option<&[u64]>,
+        out: &mut [bool],
+        ctx: &mut QueryCtx,
+    ) {
         let tri = &scene.triangles[t.idx()];
         let x = self.origin;
         let (a, b, c) = (tri.v[0] - x, tri.v[1] - x, tri.v[2] - x);
@@ -324,39 +263,45 @@ impl Fan {
         // coordinate.
         let span = [0, 1, 2].map(|k| (a[k].min(b[k]).min(c[k]), a[k].max(b[k]).max(c[k])));
         if s.iter().all(|v| v.is_finite()) {
-            let lanes = if self.whole {
-                let [x, y, z, len, sz, ..] = &self.all;
-                Lanes { x, y, z, len, sz, kz: &self.all_kz }
-            } else {
-                Lanes { x: &self.ax, y: &self.ay, z: &self.az, len: &self.al, sz: &self.asz, kz: &self.akz }
-            };
+            let [x, y, z, len, sz, ..] = &self.all;
+            let lanes = Lanes { x, y, z, len, sz, kz: &self.all_kz };
             misses(&s, &span, &lanes, &mut self.maybe);
         } else {
             self.maybe.fill(u64::MAX);
         }
         for w in 0..self.open.len() {
-            let bits = self.maybe[w] & self.open[w];
+            let bits = self.maybe[w] & self.open[w] & within.map_or(u64::MAX, |m| m[w]);
             self.exact(tri, w, bits, rays, out, ctx);
         }
     }
 }
 
-/// Masks of a walk down a list's box hierarchy ([`Fan::narrow`]): one per level, and the triangles'.
-const WALK_LEVELS: usize = super::list_boxes::MAX_LEVELS + 1;
+/// At most this many lanes of [`Fan::test_within`] go straight to the watertight test.
+const DIRECT_MAX: u32 = 3;
 
 /// Per-thread scratch of the per-light queries ([`super::Visibility::occluded_light`]).
 #[derive(Clone, Debug, Default)]
 pub struct LightScratch {
     /// The fan of the current (point, light).
     pub fan: Fan,
-    /// Per ray: how it would be answered if no candidate hits it (an index for the mode's own use).
-    pub path: Vec<u8>,
-    /// Per ray: the index of its blocker list in `lists` (`u32::MAX`: none).
-    pub list: Vec<u32>,
     /// The distinct blocker lists of the current (point, light): the mode's own keys.
     pub lists: Vec<u32>,
     /// The light's footprints on the leaf's faces.
     pub feet: Vec<super::footprint::FaceFootprint>,
     /// The `(start, len)` of the face-grid cell lists gathered in `lists` (to keep each list once).
     pub ranges: Vec<(u32, u32)>,
+    /// The stack of a walk down the scene BVH.
+    pub walk: WalkStack,
+}
+
+/// Scratch of a fan's walk down a tree (the scene BVH's, `Bvh::fan_occluded`): the nodes still to
+/// visit, each with its mask of lanes (one after the other in `masks`), and the masks of the node
+/// being visited and of the child being tested.
+#[derive(Clone, Debug, Default)]
+pub struct WalkStack {
+    pub nodes: Vec<u32>,
+    pub masks: Vec<u64>,
+    pub node_mask: Vec<u64>,
+    pub mask: Vec<u64>,
+    pub child_masks: Vec<u64>,
 }

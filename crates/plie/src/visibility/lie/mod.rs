@@ -281,7 +281,7 @@ mod tests {
         for (ri, r) in plie.records.iter().enumerate() {
             let l = vis.record_boxes.of(ri, plie.blockers_of(r));
             if l.list.len() < CHUNKED_MIN {
-                assert!(!l.is_long());
+                assert!(l.boxes.is_empty());
                 continue;
             }
             long += 1;

@@ -1,8 +1,8 @@
 //! The whole light at once (issue 21): the footprints of a light (or part of it) on the faces of the
 //! shaded point's leaf ([`super::super::footprint`]), read through summed-area tables of the face
 //! grids' cells, decide all its samples at once where they lie in umbra or in lit cells, or gather the
-//! lists of the cells they cover so that the samples are tested against those without looking up
-//! their own cells (SPEC §5, our `grid`).
+//! short lists of the cells they cover so that the samples are tested against those without looking
+//! up their own cells (SPEC §5, our `grid`). Any other light goes to the scene BVH.
 
 use glam::Vec3;
 
@@ -53,12 +53,12 @@ pub(super) enum Whole {
     /// No blocker list can hit any sample (every footprint lies in lit cells, or on records with
     /// empty lists): only the leaf's own triangles remain to test.
     Lit,
-    /// Every footprint lies in cells (or on records without a grid) with lists of at most
-    /// [`GATHER_MAX`] triangles, whose keys
-    /// are gathered: each sample's own list is one of them, so testing every sample against all of
-    /// them (and the leaf's own triangles) finds exactly its blockers.
+    /// Every footprint lies in cells (or on records without a grid) whose distinct lists hold at
+    /// most [`GATHER_MAX`] triangles in all, and their keys are gathered: each sample's own list is
+    /// one of them, so testing every sample against all of them (and the leaf's own triangles) finds
+    /// exactly its blockers.
     Lists,
-    /// The samples must be classified one by one.
+    /// None of the above: the scene answers.
     Mixed,
 }
 
@@ -77,6 +77,8 @@ impl LieVisibility<'_> {
     ) -> Whole {
         let all_exit = footprints(bounds, rays.origin, poly, SEGMENT_EPS, &mut sc.feet);
         let (mut lit, mut umbra, mut listed) = (true, all_exit, self.mode == Mode::Grid);
+        // Triangles in the distinct lists gathered so far.
+        let mut gathered = 0;
         for f in 0..sc.feet.len() {
             let fp = sc.feet[f];
             let Some(ri) = self.plie.record_id(leaf, fp.face, rays.light) else {
@@ -106,7 +108,7 @@ impl LieVisibility<'_> {
                     umbra &= count(1) == 0;
                     listed &= count(2) == 0;
                     if listed && count(0) > 0 {
-                        listed = self.gather_cells(ri, g, (i0, i1), (j0, j1), sc);
+                        listed = self.gather_cells(ri, g, (i0, i1), (j0, j1), &mut gathered, sc);
                     }
                 }
                 None => {
@@ -114,7 +116,8 @@ impl LieVisibility<'_> {
                     lit &= empty;
                     umbra = false;
                     if listed && !empty {
-                        listed = record.kind == RecordKind::Listed && (record.blockers_len as usize) < GATHER_MAX;
+                        gathered += record.blockers_len as usize;
+                        listed = record.kind == RecordKind::Listed && gathered <= GATHER_MAX;
                         sc.lists.push(ri as u32);
                     }
                 }
@@ -135,14 +138,15 @@ impl LieVisibility<'_> {
     }
 
     /// Adds the distinct non-empty lists of the cells `[i0, i1] x [j0, j1]` of record `ri`'s grid
-    /// (`g` cells a side, none of them umbra or scene) to `sc.lists`; false if one is longer than
-    /// [`GATHER_MAX`].
+    /// (`g` cells a side, none of them umbra or scene) to `sc.lists`, and their lengths to
+    /// `gathered`; false once that exceeds [`GATHER_MAX`].
     fn gather_cells(
         &self,
         ri: usize,
         g: usize,
         (i0, i1): (usize, usize),
         (j0, j1): (usize, usize),
+        gathered: &mut usize,
         sc: &mut LightScratch,
     ) -> bool {
         let first = self.plie.grids[ri].cells_start as usize;
@@ -153,7 +157,8 @@ impl LieVisibility<'_> {
                 if range.1 == 0 || sc.ranges.contains(&range) {
                     continue;
                 }
-                if range.1 as usize >= GATHER_MAX {
+                *gathered += range.1 as usize;
+                if *gathered > GATHER_MAX {
                     return false;
                 }
                 sc.ranges.push(range);
@@ -164,11 +169,11 @@ impl LieVisibility<'_> {
     }
 }
 
-/// Longest list a light's footprints gather ([`Whole::Lists`]); a light over a longer one is answered
-/// sample by sample, whose rays walk that list's hierarchy alone. Measured (callgrind of the query at
-/// 64 rays on huis-c, dragon and conference-lit): 256 needed the fewest instructions of 32, 64, 128,
-/// 256, 512, 1024 and no limit.
-pub(super) const GATHER_MAX: usize = 256;
+/// Most triangles, in all, of the distinct lists a light's footprints gather ([`Whole::Lists`]); a
+/// light over more is answered by the scene BVH. Measured (callgrind of the query at 64 rays on
+/// cornell-cube-2, huis-c, dragon, cornell-bunny and conference-lit, docs/results.md session 8): 32
+/// needed the fewest instructions in all of 16, 32, 64, 256 and 1024.
+pub(super) const GATHER_MAX: usize = 32;
 
 /// A blocker list key of a per-light query: a record's index, or a face-grid cell's index with the
 /// top bit set.

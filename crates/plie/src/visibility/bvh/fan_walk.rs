@@ -1,0 +1,128 @@
+//! A fan of shadow rays down the scene BVH at once (issues 15 and 21), as a packet: the samples of
+//! one light from one point. The `bvh` mode answers every light this way, and the P-LIE modes the
+//! lights their footprints leave open ([`crate::visibility::lie`]) and the rays through records that
+//! store no list ([`crate::lie::RecordKind::Scene`]).
+//!
+//! Each child box of a node is first culled by the pyramid from the point over the light
+//! ([`crate::visibility::pyramid::Pyramid::culls_rel`]), then tested against every ray still in the
+//! node's mask, eight lanes at a time ([`Fan::meets`]); a leaf's triangles are tested against the rays
+//! that met its box ([`Fan::test_within`]). Inner children are visited nearest first (along the
+//! first sample's direction), so that blockers close the rays early.
+//!
+//! The boxes are the BVH's own (each triangle's box padded by `PAD` in its normalised space), taken
+//! back to world units relative to the fan's apex; the rounding of that is far below the padding, so
+//! no ray that meets a triangle misses its boxes. Triangles are decided by the fan's exact test, so
+//! every answer is [`super::segment_occluded`]'s, which is brute force's.
+
+use glam::{Vec3, Vec3A};
+
+use super::crowd::{Prims, Single};
+use super::Bvh;
+use crate::scene::{Scene, TriId};
+use crate::visibility::fan::{Fan, WalkStack};
+use crate::visibility::{LightRays, QueryCtx};
+
+impl Bvh {
+    /// Tests the fan's open rays against every triangle of `scene` (but each ray's own: the
+    /// origin triangle and the light's), walking the BVH with all of them at once. Each ray a
+    /// triangle blocks gets `out[k]` set and is closed in the fan. The caller has set the fan's
+    /// pyramid for this light.
+    pub(crate) fn fan_occluded(
+        &self,
+        scene: &Scene,
+        rays: &LightRays,
+        fan: &mut Fan,
+        walk: &mut WalkStack,
+        out: &mut [bool],
+        ctx: &mut QueryCtx,
+    ) {
+        match &self.groups {
+            None => self.fan_walk(&Single, scene, rays, fan, walk, out, ctx),
+            Some(g) => self.fan_walk(g, scene, rays, fan, walk, out, ctx),
+        }
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn fan_walk<P: Prims>(
+        &self,
+        prims: &P,
+        scene: &Scene,
+        rays: &LightRays,
+        fan: &mut Fan,
+        walk: &mut WalkStack,
+        out: &mut [bool],
+        ctx: &mut QueryCtx,
+    ) {
+        let w = fan.words();
+        if self.cw.nodes.is_empty() || fan.live() == 0 {
+            return;
+        }
+        let apex = self.to_local(fan.origin());
+        let to_world = 1.0 / self.scale;
+        walk.nodes.clear();
+        walk.masks.clear();
+        walk.nodes.push(0);
+        walk.masks.extend_from_slice(fan.open());
+        walk.mask.resize(w, 0);
+        walk.child_masks.resize(8 * w, 0);
+        // The order of inner children: nearest first along the first sample's direction.
+        let toward = rays.targets[0] - fan.origin();
+        let WalkStack { nodes, masks, node_mask, mask, child_masks } = walk;
+        while let Some(ni) = nodes.pop() {
+            let at = masks.len() - w;
+            node_mask.clear();
+            node_mask.extend_from_slice(&masks[at..]);
+            masks.truncate(at);
+            let node = &self.cw.nodes[ni as usize];
+            let e = node.compute_extent();
+            // The node's corner relative to the apex, in normalised units.
+            let base = Vec3A::from(node.p) - apex;
+            let mut pending = [(0f32, 0u32, 0usize); 8];
+            let mut count = 0;
+            for child in 0..8 {
+                if node.child_meta[child] == 0 {
+                    continue;
+                }
+                let q = |v: [u8; 8]| f32::from(v[child]);
+                let lo = base + e * Vec3A::new(q(node.child_min_x), q(node.child_min_y), q(node.child_min_z));
+                let hi = base + e * Vec3A::new(q(node.child_max_x), q(node.child_max_y), q(node.child_max_z));
+                let (lo, hi) = (Vec3::from(lo * to_world), Vec3::from(hi * to_world));
+                if fan.pyramid.culls_rel(lo, hi) {
+                    continue;
+                }
+                if !fan.meets(lo, hi, node_mask, mask, ctx) {
+                    continue;
+                }
+                if node.is_leaf(child) {
+                    let (start, len) = node.child_primitives(child);
+                    for p in start..start + len {
+                        for &t in prims.of(&self.cw.primitive_indices[p as usize]) {
+                            let t = TriId(t);
+                            if t == rays.origin_tri || scene.tri_light[t.idx()] == Some(rays.light) {
+                                continue;
+                            }
+                            fan.test_within(scene, rays, t, mask, out, ctx);
+                        }
+                    }
+                    if fan.live() == 0 {
+                        return;
+                    }
+                } else {
+                    let key = (lo + hi).dot(toward);
+                    child_masks[count * w..(count + 1) * w].copy_from_slice(mask);
+                    pending[count] = (key, node.child_node_index(child), count);
+                    count += 1;
+                }
+            }
+            if count > 0 {
+                // Nearest last, so it is visited first.
+                let pending = &mut pending[..count];
+                pending.sort_unstable_by(|a, b| b.0.total_cmp(&a.0));
+                for &(_, n, slot) in pending.iter() {
+                    nodes.push(n);
+                    masks.extend_from_slice(&child_masks[slot * w..(slot + 1) * w]);
+                }
+            }
+        }
+    }
+}
