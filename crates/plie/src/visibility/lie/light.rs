@@ -2,10 +2,11 @@
 //! point at once ([`Visibility::occluded_light`](super::super::Visibility::occluded_light)). The light's
 //! footprints on the leaf's faces ([`super::whole`]) answer the whole light where they lie in lit
 //! cells or in umbra, or gather the short lists of the cells under them, tested as a fan
-//! ([`super::super::fan`]). Any other light (footprints over penumbra and umbra alike, long lists,
-//! records that store no list) is answered by the scene BVH, all samples at once
-//! (`Bvh::fan_occluded`): measured, that beat finding each sample's exit face, record and cell and
-//! testing its own list on every scene tried (docs/results.md, session 8).
+//! ([`super::super::fan`]) with the leaf's own triangles. Any other light (footprints over penumbra
+//! and umbra alike, long lists, records that store no list, a leaf crowded with triangles of its
+//! own) is answered by the scene BVH, all samples at once (`Bvh::fan_occluded`): measured, that beat
+//! finding each sample's exit face, record and cell and testing its own list on every scene tried
+//! (docs/results.md, session 8).
 
 use super::super::fan::{Fan, LightScratch, Pyramid};
 use super::super::list_boxes::{Chunked, ListVisitor};
@@ -52,7 +53,8 @@ impl LieVisibility<'_> {
 
     /// All samples of one light from one point (issue 21), by the footprints' verdict
     /// ([`Whole`]): all occluded; lit but for the leaf's own triangles; the gathered lists and the
-    /// leaf's own triangles as a fan; or the scene BVH. Every candidate set holds each ray's true
+    /// leaf's own triangles as a fan (for a leaf of at most [`OWN_MAX`] triangles); or the scene
+    /// BVH. Every candidate set holds each ray's true
     /// blockers, and each triangle is decided by the watertight test, so every answer is the per-ray
     /// answer.
     pub(super) fn answer_light(&self, rays: &LightRays, out: &mut [bool], ctx: &mut QueryCtx) {
@@ -75,6 +77,8 @@ impl LieVisibility<'_> {
                 ctx.stats.lights.whole_umbra += 1;
                 ctx.stats.answers.count_n(Answer::Umbra, out.len());
             }
+            // A leaf with many triangles of its own: the BVH culls them better than the fan does.
+            Whole::Lit | Whole::Lists if self.own[leaf.idx()].1 as usize > OWN_MAX => self.by_scene(rays, sc, out, ctx),
             Whole::Lit => self.own_only(leaf, rays, sc, out, ctx),
             Whole::Lists => self.lists_only(leaf, rays, sc, out, ctx),
             Whole::Mixed => self.by_scene(rays, sc, out, ctx),
@@ -231,3 +235,9 @@ impl LieVisibility<'_> {
         }
     }
 }
+
+/// Most triangles of its own a leaf may hold for its lit or gathered lights to be tested as a fan;
+/// with more, the scene BVH answers. Measured (callgrind of the query at 64 rays on cornell-cube-2,
+/// huis-c, dragon, cornell-bunny and conference-lit, docs/results.md session 8): 32 needed the fewest
+/// instructions in all of 16, 32, 64, 128 and no limit.
+const OWN_MAX: usize = 32;
