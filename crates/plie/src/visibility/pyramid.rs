@@ -92,8 +92,9 @@ impl Pyramid {
     }
 
     /// True if no segment of the pyramid can meet anything in the box `[lo, hi]`, given relative to
-    /// the apex. Only the side planes are tested.
-    #[inline]
+    /// the apex. Only the side planes are tested. (The walks use [`Pyramid::culls_rel8`]; this is
+    /// its reference.)
+    #[cfg(test)]
     pub fn culls_rel(&self, lo: Vec3, hi: Vec3) -> bool {
         let m = self.margin;
         if let Some([sx, sy, sz]) = self.lanes {
@@ -104,6 +105,24 @@ impl Pyramid {
             return d.cmplt(Vec4::splat(-m)).any();
         }
         self.sides.iter().any(|s| s.dot(Vec3::select(s.cmpge(Vec3::ZERO), hi, lo)) < -m)
+    }
+
+    /// Which of eight boxes, given relative to the apex as lanes (`lo[axis][c]`, `hi[axis][c]` for
+    /// box `c`), no segment of the pyramid can meet: bit `c` is set if box `c` lies beyond a side
+    /// plane (the corner farthest along its normal still beyond it by the margin). Only the side
+    /// planes are tested.
+    #[inline]
+    pub fn culls_rel8(&self, lo: &[[f32; 8]; 3], hi: &[[f32; 8]; 3]) -> u8 {
+        let m = -self.margin;
+        let mut culled = [false; 8];
+        for s in &self.sides {
+            let far = |k: usize| if s[k] >= 0.0 { &hi[k] } else { &lo[k] };
+            let (fx, fy, fz) = (far(0), far(1), far(2));
+            for c in 0..8 {
+                culled[c] |= s.x * fx[c] + s.y * fy[c] + s.z * fz[c] < m;
+            }
+        }
+        culled.iter().enumerate().fold(0, |bits, (c, &k)| bits | u8::from(k) << c)
     }
 
     /// True if no segment of the pyramid can meet anything in the box `b`.
@@ -170,5 +189,42 @@ mod tests {
         }
         // Both answers occur.
         assert!(culled > 1000 && culled < 59_000, "{culled}");
+    }
+
+    /// Eight boxes at once decide as one at a time, on random boxes around the pyramid.
+    #[test]
+    fn eight_box_cull_equals_one_at_a_time() {
+        let light = Light::new(
+            vec![
+                Vec3::new(0.0, 2.0, 0.0),
+                Vec3::new(1.0, 2.0, 0.0),
+                Vec3::new(1.0, 2.0, 1.0),
+                Vec3::new(0.0, 2.0, 1.0),
+            ],
+            Vec3::ONE,
+            vec![],
+        )
+        .unwrap();
+        let mut p = Pyramid::default();
+        let apex = Vec3::new(0.3, 0.0, 0.4);
+        assert!(p.set(apex, &light, 1e-4));
+        let mut rng = Rng::stream(8, 0, 0, 0);
+        let mut culled = 0;
+        for _ in 0..5_000 {
+            let (mut lo, mut hi) = ([[0f32; 8]; 3], [[0f32; 8]; 3]);
+            for c in 0..8 {
+                for k in 0..3 {
+                    let (a, b) = (rng.next_f32() * 4.0 - 2.0, rng.next_f32() * 4.0 - 2.0);
+                    (lo[k][c], hi[k][c]) = (a.min(b), a.max(b));
+                }
+            }
+            let bits = p.culls_rel8(&lo, &hi);
+            for c in 0..8 {
+                let one = p.culls_rel(Vec3::new(lo[0][c], lo[1][c], lo[2][c]), Vec3::new(hi[0][c], hi[1][c], hi[2][c]));
+                assert_eq!(bits >> c & 1 == 1, one, "box {c}");
+                culled += usize::from(one);
+            }
+        }
+        assert!(culled > 1000 && culled < 39_000, "{culled}");
     }
 }

@@ -3,11 +3,11 @@
 //! lights their footprints leave open ([`crate::visibility::lie`]) and the rays through records that
 //! store no list ([`crate::lie::RecordKind::Scene`]).
 //!
-//! Each child box of a node is first culled by the pyramid from the point over the light
-//! ([`crate::visibility::pyramid::Pyramid::culls_rel`]), then tested against every ray still in the
-//! node's mask, eight lanes at a time ([`Fan::meets`]); a leaf's triangles are tested against the rays
-//! that met its box ([`Fan::test_within`]). Inner children are visited nearest first (along the
-//! first sample's direction), so that blockers close the rays early.
+//! A node's eight child boxes are first culled by the pyramid from the point over the light
+//! ([`crate::visibility::pyramid::Pyramid::culls_rel8`]), then each is tested against every ray
+//! still in the node's mask, eight lanes at a time ([`Fan::meets`]); a leaf's triangles are tested
+//! against the rays that met its box ([`Fan::test_within`]). Inner children are visited nearest
+//! first (along the first sample's direction), so that blockers close the rays early.
 //!
 //! The boxes are the BVH's own (each triangle's box padded by `PAD` in its normalised space), taken
 //! back to world units relative to the fan's apex; the rounding of that is far below the padding, so
@@ -70,26 +70,35 @@ impl Bvh {
         let WalkStack { nodes, masks, node_mask, mask, child_masks } = walk;
         while let Some(ni) = nodes.pop() {
             let at = masks.len() - w;
+            // Word by word: masks are one or two words, too short for a copy call.
             node_mask.clear();
-            node_mask.extend_from_slice(&masks[at..]);
+            for i in at..at + w {
+                node_mask.push(masks[i]);
+            }
             masks.truncate(at);
             let node = &self.cw.nodes[ni as usize];
             let e = node.compute_extent();
             // The node's corner relative to the apex, in normalised units.
             let base = Vec3A::from(node.p) - apex;
+            // The children's boxes relative to the apex, in world units, eight lanes per bound.
+            let (mut los, mut his) = ([[0f32; 8]; 3], [[0f32; 8]; 3]);
+            let mins = [&node.child_min_x, &node.child_min_y, &node.child_min_z];
+            let maxs = [&node.child_max_x, &node.child_max_y, &node.child_max_z];
+            for k in 0..3 {
+                for c in 0..8 {
+                    los[k][c] = (base[k] + e[k] * f32::from(mins[k][c])) * to_world;
+                    his[k][c] = (base[k] + e[k] * f32::from(maxs[k][c])) * to_world;
+                }
+            }
+            let culled = fan.pyramid.culls_rel8(&los, &his);
             let mut pending = [(0f32, 0u32, 0usize); 8];
             let mut count = 0;
             for child in 0..8 {
-                if node.child_meta[child] == 0 {
+                if node.child_meta[child] == 0 || culled >> child & 1 != 0 {
                     continue;
                 }
-                let q = |v: [u8; 8]| f32::from(v[child]);
-                let lo = base + e * Vec3A::new(q(node.child_min_x), q(node.child_min_y), q(node.child_min_z));
-                let hi = base + e * Vec3A::new(q(node.child_max_x), q(node.child_max_y), q(node.child_max_z));
-                let (lo, hi) = (Vec3::from(lo * to_world), Vec3::from(hi * to_world));
-                if fan.pyramid.culls_rel(lo, hi) {
-                    continue;
-                }
+                let lo = Vec3::new(los[0][child], los[1][child], los[2][child]);
+                let hi = Vec3::new(his[0][child], his[1][child], his[2][child]);
                 if !fan.meets(lo, hi, node_mask, mask, ctx) {
                     continue;
                 }
@@ -109,7 +118,9 @@ impl Bvh {
                     }
                 } else {
                     let key = (lo + hi).dot(toward);
-                    child_masks[count * w..(count + 1) * w].copy_from_slice(mask);
+                    for (i, &m) in mask.iter().enumerate() {
+                        child_masks[count * w + i] = m;
+                    }
                     pending[count] = (key, node.child_node_index(child), count);
                     count += 1;
                 }
@@ -120,7 +131,9 @@ impl Bvh {
                 pending.sort_unstable_by(|a, b| b.0.total_cmp(&a.0));
                 for &(_, n, slot) in pending.iter() {
                     nodes.push(n);
-                    masks.extend_from_slice(&child_masks[slot * w..(slot + 1) * w]);
+                    for i in slot * w..(slot + 1) * w {
+                        masks.push(child_masks[i]);
+                    }
                 }
             }
         }
