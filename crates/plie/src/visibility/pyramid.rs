@@ -114,15 +114,15 @@ impl Pyramid {
     #[inline]
     pub fn culls_rel8(&self, lo: &[[f32; 8]; 3], hi: &[[f32; 8]; 3]) -> u8 {
         let m = -self.margin;
-        let mut culled = [false; 8];
-        for s in &self.sides {
-            let far = |k: usize| if s[k] >= 0.0 { &hi[k] } else { &lo[k] };
+        let mut culled = [0u32; 8];
+        for s in self.sides.iter().copied() {
+            let far = |k: usize| if s[k] >= 0.0 { hi[k] } else { lo[k] };
             let (fx, fy, fz) = (far(0), far(1), far(2));
             for c in 0..8 {
-                culled[c] |= s.x * fx[c] + s.y * fy[c] + s.z * fz[c] < m;
+                culled[c] |= u32::from(s.x * fx[c] + s.y * fy[c] + s.z * fz[c] < m);
             }
         }
-        culled.iter().enumerate().fold(0, |bits, (c, &k)| bits | u8::from(k) << c)
+        (0..8).fold(0, |bits, c| bits | (culled[c] as u8) << c)
     }
 
     /// True if no segment of the pyramid can meet anything in the box `b`.
