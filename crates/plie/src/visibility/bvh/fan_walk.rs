@@ -63,11 +63,10 @@ impl Bvh {
         walk.masks.clear();
         walk.nodes.push(0);
         walk.masks.extend_from_slice(fan.open());
-        walk.mask.resize(w, 0);
         walk.child_masks.resize(8 * w, 0);
         // The order of inner children: nearest first along the first sample's direction.
         let toward = rays.targets[0] - fan.origin();
-        let WalkStack { nodes, masks, node_mask, mask, child_masks } = walk;
+        let WalkStack { nodes, masks, node_mask, child_masks } = walk;
         while let Some(ni) = nodes.pop() {
             let at = masks.len() - w;
             // Word by word: masks are one or two words, too short for a copy call.
@@ -76,6 +75,10 @@ impl Bvh {
                 node_mask.push(masks[i]);
             }
             masks.truncate(at);
+            // Its rays may all have been closed since it was pushed.
+            if node_mask.iter().zip(fan.open()).all(|(m, o)| m & o == 0) {
+                continue;
+            }
             let node = &self.cw.nodes[ni as usize];
             let e = node.compute_extent();
             // The node's corner relative to the apex, in normalised units.
@@ -91,17 +94,12 @@ impl Bvh {
                 }
             }
             let culled = fan.pyramid.culls_rel8(&los, &his);
+            let filled = node.child_meta.iter().enumerate().fold(0u8, |b, (c, &m)| b | u8::from(m != 0) << c);
+            let hit = fan.meets8(&los, &his, filled & !culled, node_mask, child_masks, ctx);
             let mut pending = [(0f32, 0u32, 0usize); 8];
             let mut count = 0;
-            for child in 0..8 {
-                if node.child_meta[child] == 0 || culled >> child & 1 != 0 {
-                    continue;
-                }
-                let lo = Vec3::new(los[0][child], los[1][child], los[2][child]);
-                let hi = Vec3::new(his[0][child], his[1][child], his[2][child]);
-                if !fan.meets(lo, hi, node_mask, mask, ctx) {
-                    continue;
-                }
+            for child in (0..8).filter(|c| hit >> c & 1 != 0) {
+                let mask = &child_masks[child * w..(child + 1) * w];
                 if node.is_leaf(child) {
                     let (start, len) = node.child_primitives(child);
                     for p in start..start + len {
@@ -117,11 +115,12 @@ impl Bvh {
                         return;
                     }
                 } else {
-                    let key = (lo + hi).dot(toward);
-                    for (i, &m) in mask.iter().enumerate() {
-                        child_masks[count * w + i] = m;
-                    }
-                    pending[count] = (key, node.child_node_index(child), count);
+                    let centre = Vec3::new(
+                        los[0][child] + his[0][child],
+                        los[1][child] + his[1][child],
+                        los[2][child] + his[2][child],
+                    );
+                    pending[count] = (centre.dot(toward), node.child_node_index(child), child);
                     count += 1;
                 }
             }

@@ -109,9 +109,58 @@ pub(super) fn meets_box(lo: Vec3, hi: Vec3, lanes: &BoxLanes, base: usize, withi
     out
 }
 
+/// [`meets_box`] for each box `c` of eight with bit `c` of `alive` set, given as lanes
+/// (`lo[axis][c]`, `hi[axis][c]`): `out[c]` becomes the bits of `within` whose segments meet box `c`
+/// (0 for the others).
+#[inline]
+pub(super) fn meets_boxes(
+    lo: &[[f32; 8]; 3],
+    hi: &[[f32; 8]; 3],
+    alive: u8,
+    lanes: &BoxLanes,
+    base: usize,
+    within: u64,
+    out: &mut [u64; 8],
+) {
+    let corner = |v: &[[f32; 8]; 3], c: usize| Vec3::new(v[0][c], v[1][c], v[2][c]);
+    #[cfg(target_arch = "x86_64")]
+    if std::arch::is_x86_feature_detected!("avx2") {
+        // SAFETY: AVX2 is available (checked above); the lane arrays are padded to whole blocks.
+        unsafe { meets_boxes_avx(lo, hi, alive, lanes, base, within, out) };
+        return;
+    }
+    for c in 0..8 {
+        out[c] = if alive >> c & 1 != 0 { meets_box(corner(lo, c), corner(hi, c), lanes, base, within) } else { 0 };
+    }
+}
+
+/// [`meets_boxes`] in one call with AVX2, each box by [`meets_box_avx`].
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx,avx2")]
+unsafe fn meets_boxes_avx(
+    lo: &[[f32; 8]; 3],
+    hi: &[[f32; 8]; 3],
+    alive: u8,
+    lanes: &BoxLanes,
+    base: usize,
+    within: u64,
+    out: &mut [u64; 8],
+) {
+    for c in 0..8 {
+        out[c] = if alive >> c & 1 != 0 {
+            let (l, h) = (Vec3::new(lo[0][c], lo[1][c], lo[2][c]), Vec3::new(hi[0][c], hi[1][c], hi[2][c]));
+            // SAFETY: the caller's guarantees.
+            unsafe { meets_box_avx(l, h, lanes, base, within) }
+        } else {
+            0
+        };
+    }
+}
+
 /// [`meets_box`], eight lanes at a time (blocks of lanes with no bit in `within` are skipped).
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx,avx2")]
+#[inline]
 unsafe fn meets_box_avx(lo: Vec3, hi: Vec3, lanes: &BoxLanes, base: usize, within: u64) -> u64 {
     use std::arch::x86_64::*;
     let sp = |v: f32| _mm256_set1_ps(v);

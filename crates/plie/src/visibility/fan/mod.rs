@@ -28,7 +28,7 @@ mod lanes;
 
 #[cfg(target_arch = "x86_64")]
 use lanes::ray_lanes_avx;
-use lanes::{inverse, meets_box, misses, BoxLanes, Lanes};
+use lanes::{inverse, meets_boxes, misses, BoxLanes, Lanes};
 
 /// Relative margin of the edge functions. The watertight test's sheared edge function of an edge
 /// `(p, q)` differs from the real `det(p, q, d) / d_kz` by at most about `32 ε |p| |q|` (the shear has
@@ -178,20 +178,40 @@ impl Fan {
         self.origin
     }
 
-    /// `to` becomes the open lanes of `within` whose segments meet the box `[lo, hi]` (given
-    /// relative to the apex), by the slab test of [`Fan::narrow`]. Returns whether any does.
+    /// For each box `c` of eight with bit `c` of `alive` set, given relative to the apex as lanes
+    /// (`lo[axis][c]`, `hi[axis][c]`): `to[c * w..(c + 1) * w]` (`w` = [`Fan::words`]) becomes the
+    /// open rays of `within` whose segments meet it, by the slab test (eight rays at a time; it never
+    /// drops a ray whose segment meets the box). Returns the boxes some ray meets, as bits. Counts a
+    /// box test per ray and box tested.
     #[inline]
-    pub fn meets(&self, lo: Vec3, hi: Vec3, within: &[u64], to: &mut [u64], ctx: &mut QueryCtx) -> bool {
+    pub fn meets8(
+        &self,
+        lo: &[[f32; 8]; 3],
+        hi: &[[f32; 8]; 3],
+        alive: u8,
+        within: &[u64],
+        to: &mut [u64],
+        ctx: &mut QueryCtx,
+    ) -> u8 {
         let [.., ix, iy, iz] = &self.all;
         let lanes = BoxLanes { ix, iy, iz };
-        let mut any = 0;
-        for (i, (t, &w)) in to.iter_mut().zip(within).enumerate() {
-            let f = w & self.open[i];
-            ctx.stats.box_tests += u64::from(f.count_ones());
-            *t = if f == 0 { 0 } else { meets_box(lo, hi, &lanes, i * 64, f) };
-            any |= *t;
+        let w = self.open.len();
+        let mut hit = 0u8;
+        let mut out = [0u64; 8];
+        for i in 0..w {
+            let f = within[i] & self.open[i];
+            if f == 0 {
+                out = [0; 8];
+            } else {
+                ctx.stats.box_tests += u64::from(f.count_ones() * alive.count_ones());
+                meets_boxes(lo, hi, alive, &lanes, i * 64, f, &mut out);
+            }
+            for (c, &o) in out.iter().enumerate() {
+                to[c * w + i] = o;
+                hit |= u8::from(o != 0) << c;
+            }
         }
-        any != 0
+        hit
     }
 
     /// [`Fan::test`] for the open lanes of `within` only: a few lanes go straight to the watertight
@@ -295,13 +315,12 @@ pub struct LightScratch {
 }
 
 /// Scratch of a fan's walk down a tree (the scene BVH's, `Bvh::fan_occluded`): the nodes still to
-/// visit, each with its mask of lanes (one after the other in `masks`), and the masks of the node
-/// being visited and of the child being tested.
+/// visit, each with its mask of rays (one after the other in `masks`), and the masks of the node
+/// being visited and of its eight children.
 #[derive(Clone, Debug, Default)]
 pub struct WalkStack {
     pub nodes: Vec<u32>,
     pub masks: Vec<u64>,
     pub node_mask: Vec<u64>,
-    pub mask: Vec<u64>,
     pub child_masks: Vec<u64>,
 }
