@@ -93,7 +93,7 @@ pub struct QueryStats {
     pub lights: LightAnswers,
 }
 
-/// How the P-LIE modes answered the (point, light) pairs: all samples at once, or sample by sample.
+/// How the P-LIE modes answered the (point, light) pairs of the per-light query.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
 pub struct LightAnswers {
     /// Pairs asked.

@@ -71,8 +71,8 @@ impl Bvh {
             let at = masks.len() - w;
             // Word by word: masks are one or two words, too short for a copy call.
             node_mask.clear();
-            for i in at..at + w {
-                node_mask.push(masks[i]);
+            for &m in &masks[at..at + w] {
+                node_mask.push(m);
             }
             masks.truncate(at);
             // Its rays may all have been closed since it was pushed.
@@ -130,8 +130,8 @@ impl Bvh {
                 pending.sort_unstable_by(|a, b| b.0.total_cmp(&a.0));
                 for &(_, n, slot) in pending.iter() {
                     nodes.push(n);
-                    for i in slot * w..(slot + 1) * w {
-                        masks.push(child_masks[i]);
+                    for &m in &child_masks[slot * w..(slot + 1) * w] {
+                        masks.push(m);
                     }
                 }
             }

@@ -207,7 +207,7 @@ impl Visibility for BvhVisibility<'_> {
         segment_occluded(self.scene, self.bvh, ray, ctx)
     }
 
-    /// All samples of the light down the BVH at once ([`Bvh::fan_occluded`]), as a packet; a few
+    /// All samples of the light down the BVH at once (`Bvh::fan_occluded`), as a packet; a few
     /// samples ray by ray.
     fn occluded_light(&self, rays: &LightRays, out: &mut [bool], ctx: &mut QueryCtx) {
         if rays.targets.len() < crate::visibility::FAN_MIN {

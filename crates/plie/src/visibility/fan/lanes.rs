@@ -129,8 +129,8 @@ pub(super) fn meets_boxes(
         unsafe { meets_boxes_avx(lo, hi, alive, lanes, base, within, out) };
         return;
     }
-    for c in 0..8 {
-        out[c] = if alive >> c & 1 != 0 { meets_box(corner(lo, c), corner(hi, c), lanes, base, within) } else { 0 };
+    for (c, o) in out.iter_mut().enumerate() {
+        *o = if alive >> c & 1 != 0 { meets_box(corner(lo, c), corner(hi, c), lanes, base, within) } else { 0 };
     }
 }
 

@@ -229,8 +229,8 @@ impl Fan {
         let few = within.iter().zip(&self.open).map(|(w, o)| (w & o).count_ones()).sum::<u32>() <= DIRECT_MAX;
         if few {
             let tri = &scene.triangles[t.idx()];
-            for w in 0..self.open.len() {
-                let bits = within[w] & self.open[w];
+            for (w, &m) in within.iter().enumerate().take(self.open.len()) {
+                let bits = m & self.open[w];
                 self.exact(tri, w, bits, rays, out, ctx);
             }
         } else {

@@ -17,6 +17,10 @@
 //!
 //! Each ray is counted on the [`Answer`] path that decided it, and its triangle tests are split into
 //! blocker tests and own-leaf tests (`plie render --stats`).
+//!
+//! All the samples of one light from one point (the per-light query, issue 21) are answered together
+//! in `light.rs`: from the light's footprints on the leaf's faces where they decide it, else by
+//! the scene BVH walked by all the samples at once.
 
 mod light;
 mod whole;
