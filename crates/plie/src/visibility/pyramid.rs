@@ -5,8 +5,8 @@
 
 use glam::{Vec3, Vec4};
 
-use crate::geometry::{Aabb, Triangle};
-use crate::scene::Light;
+use crate::geometry::{Aabb, Triangle, TOLERANCE_REL};
+use crate::scene::{Light, LightId, Scene};
 
 /// The pyramid conv(`x` ∪ light polygon), as planes with inward unit normals through `x` (one per
 /// light edge) and the light's own plane, each grown outward by `margin`.
@@ -62,6 +62,12 @@ impl Pyramid {
             self.lanes = Some([lane(|v| v.x), lane(|v| v.y), lane(|v| v.z)]);
         }
         true
+    }
+
+    /// [`Pyramid::set`] from `x` over light `light` of `scene`, grown by the margin every per-light
+    /// query uses: ten times the scene's tolerance ([`TOLERANCE_REL`] of its size).
+    pub fn set_in(&mut self, scene: &Scene, x: Vec3, light: LightId) -> bool {
+        self.set(x, &scene.lights[light.idx()], scene.scale() * TOLERANCE_REL * 10.0)
     }
 
     /// True if no segment from the apex to a point of the light (within the margin) can meet

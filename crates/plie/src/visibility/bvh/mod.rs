@@ -219,11 +219,7 @@ impl Visibility for BvhVisibility<'_> {
         let mut sc = std::mem::take(&mut ctx.light);
         out.fill(false);
         sc.fan.set(rays);
-        sc.fan.pyramid.set(
-            rays.origin,
-            &self.scene.lights[rays.light.idx()],
-            self.scene.scale() * crate::geometry::TOLERANCE_REL * 10.0,
-        );
+        sc.fan.pyramid.set_in(self.scene, rays.origin, rays.light);
         self.bvh.fan_occluded(self.scene, rays, &mut sc.fan, &mut sc.walk, out, ctx);
         ctx.light = sc;
     }

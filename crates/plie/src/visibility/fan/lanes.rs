@@ -122,15 +122,22 @@ pub(super) fn meets_boxes(
     within: u64,
     out: &mut [u64; 8],
 ) {
-    let corner = |v: &[[f32; 8]; 3], c: usize| Vec3::new(v[0][c], v[1][c], v[2][c]);
     #[cfg(target_arch = "x86_64")]
     if std::arch::is_x86_feature_detected!("avx2") {
         // SAFETY: AVX2 is available (checked above); the lane arrays are padded to whole blocks.
         unsafe { meets_boxes_avx(lo, hi, alive, lanes, base, within, out) };
         return;
     }
+    each_box(lo, hi, alive, out, |l, h| meets_box(l, h, lanes, base, within));
+}
+
+/// `out[c]` becomes `meets(lo_c, hi_c)` for each box `c` with bit `c` of `alive` set, 0 for the
+/// others (the loop of [`meets_boxes`], inlined into each of its two paths).
+#[inline(always)]
+fn each_box(lo: &[[f32; 8]; 3], hi: &[[f32; 8]; 3], alive: u8, out: &mut [u64; 8], meets: impl Fn(Vec3, Vec3) -> u64) {
+    let corner = |v: &[[f32; 8]; 3], c: usize| Vec3::new(v[0][c], v[1][c], v[2][c]);
     for (c, o) in out.iter_mut().enumerate() {
-        *o = if alive >> c & 1 != 0 { meets_box(corner(lo, c), corner(hi, c), lanes, base, within) } else { 0 };
+        *o = if alive >> c & 1 != 0 { meets(corner(lo, c), corner(hi, c)) } else { 0 };
     }
 }
 
@@ -146,15 +153,8 @@ unsafe fn meets_boxes_avx(
     within: u64,
     out: &mut [u64; 8],
 ) {
-    for c in 0..8 {
-        out[c] = if alive >> c & 1 != 0 {
-            let (l, h) = (Vec3::new(lo[0][c], lo[1][c], lo[2][c]), Vec3::new(hi[0][c], hi[1][c], hi[2][c]));
-            // SAFETY: the caller's guarantees.
-            unsafe { meets_box_avx(l, h, lanes, base, within) }
-        } else {
-            0
-        };
-    }
+    // SAFETY: the caller's guarantees.
+    each_box(lo, hi, alive, out, |l, h| unsafe { meets_box_avx(l, h, lanes, base, within) });
 }
 
 /// [`meets_box`], eight lanes at a time (blocks of lanes with no bit in `within` are skipped).

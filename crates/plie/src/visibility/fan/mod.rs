@@ -238,7 +238,7 @@ impl Fan {
         }
     }
 
-    /// Active rays not yet found occluded.
+    /// Rays not yet found occluded.
     #[inline]
     pub fn live(&self) -> usize {
         self.live

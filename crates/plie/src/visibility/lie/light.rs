@@ -24,7 +24,7 @@ impl LieVisibility<'_> {
         out.fill(false);
         let lanes_before = ctx.stats.lane_tests;
         sc.fan.set(rays);
-        sc.fan.pyramid.set(rays.origin, &self.scene.lights[rays.light.idx()], self.pad * 10.0);
+        sc.fan.pyramid.set_in(self.scene, rays.origin, rays.light);
         ctx.begin_query();
         let before = ctx.stats.triangle_tests;
         for &key in &sc.lists {
@@ -91,7 +91,7 @@ impl LieVisibility<'_> {
         out.fill(false);
         ctx.stats.lights.scene += 1;
         sc.fan.set(rays);
-        sc.fan.pyramid.set(rays.origin, &self.scene.lights[rays.light.idx()], self.pad * 10.0);
+        sc.fan.pyramid.set_in(self.scene, rays.origin, rays.light);
         let before = ctx.stats.triangle_tests;
         self.bvh.fan_occluded(self.scene, rays, &mut sc.fan, &mut sc.walk, out, ctx);
         ctx.stats.blocker_tests += ctx.stats.triangle_tests - before;
@@ -117,8 +117,7 @@ impl LieVisibility<'_> {
     /// leaf itself blocks it. Those meeting the pyramid (usually none) are tested as a fan.
     fn own_only(&self, leaf: LeafId, rays: &LightRays, sc: &mut LightScratch, out: &mut [bool], ctx: &mut QueryCtx) {
         out.fill(false);
-        let margin = self.pad * 10.0;
-        sc.fan.pyramid.set(rays.origin, &self.scene.lights[rays.light.idx()], margin);
+        sc.fan.pyramid.set_in(self.scene, rays.origin, rays.light);
         let (start, len) = self.own[leaf.idx()];
         let own = self.own_boxes.of(leaf.idx(), &self.own_tris[start as usize..(start + len) as usize]);
         let before = ctx.stats.triangle_tests;

@@ -57,8 +57,6 @@ pub struct LieVisibility<'a> {
     record_boxes: ListBoxes,
     /// Chunk boxes of the face-grid cells' lists.
     cell_boxes: ListBoxes,
-    /// The construction tolerance (how far triangle boxes are grown).
-    pad: f32,
     /// Per leaf, its own triangles in Morton order (`(start, len)` into `own_tris`), with chunk
     /// boxes: the per-light query culls them by chunk against its pyramid.
     own: Vec<(u32, u32)>,
@@ -108,7 +106,6 @@ impl<'a> LieVisibility<'a> {
             mode,
             record_boxes,
             cell_boxes,
-            pad,
             own,
             own_tris,
             own_boxes,
