@@ -55,6 +55,13 @@ impl RayTest {
         RayTest { origin, dir, t_min, t_max, kx, ky, kz, sx: dir[kx] * sz, sy: dir[ky] * sz, sz }
     }
 
+    /// The shear of the test: `[sx, sy, sz]` and the axes `[kx, ky, kz]` (for lane-wide copies of
+    /// [`RayTest::hit`] that must compute exactly what it computes).
+    #[inline]
+    pub fn shear(&self) -> ([f32; 3], [u32; 3]) {
+        ([self.sx, self.sy, self.sz], [self.kx as u32, self.ky as u32, self.kz as u32])
+    }
+
     /// The parameter `t` of the hit with `tri`, if the ray hits it strictly inside `(t_min, t_max)`.
     /// Both sides of the triangle count. Degenerate triangles are never hit.
     #[inline]

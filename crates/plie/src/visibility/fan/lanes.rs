@@ -75,6 +75,82 @@ pub(super) unsafe fn ray_lanes_avx(d: [&[f32]; 3], out: [&mut [f32]; 5], kz: &mu
     n
 }
 
+/// The rest of each ray's shear for the watertight test, as [`crate::geometry::RayTest::new`]
+/// computes it from the direction `d`, `sz = 1 / d[kz]` and `kz`: the axes `kx = kz + 1`, `ky = kx + 1`
+/// (mod 3, swapped where `d[kz] < 0`) and `sx = d[kx] sz`, `sy = d[ky] sz`, into `s` and `k`. Eight
+/// rays at a time with AVX2 where available, each lane as the scalar code computes it.
+pub(super) fn shear_lanes(d: [&[f32]; 3], sz: &[f32], kz: &[u32], s: [&mut [f32]; 2], k: [&mut [u32]; 2]) {
+    let n = d
+        .iter()
+        .map(|v| v.len())
+        .chain([sz.len(), kz.len(), s[0].len(), s[1].len(), k[0].len(), k[1].len()])
+        .min()
+        .unwrap_or(0);
+    let [sx, sy] = s;
+    let [kx, ky] = k;
+    let mut done = 0;
+    #[cfg(target_arch = "x86_64")]
+    if std::arch::is_x86_feature_detected!("avx2") {
+        // SAFETY: AVX2 is available (checked above); every array holds at least `n` lanes.
+        done = unsafe { shear_lanes_avx(d, sz, kz, [sx, sy], [kx, ky], n) };
+    }
+    for j in done..n {
+        let z = kz[j] as usize;
+        let (mut x, mut y) = ((z + 1) % 3, (z + 2) % 3);
+        if d[z][j] < 0.0 {
+            std::mem::swap(&mut x, &mut y);
+        }
+        (kx[j], ky[j]) = (x as u32, y as u32);
+        sx[j] = d[x][j] * sz[j];
+        sy[j] = d[y][j] * sz[j];
+    }
+}
+
+/// [`shear_lanes`] for the whole blocks of eight among the first `n` lanes; returns how many lanes
+/// it did.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx,avx2")]
+unsafe fn shear_lanes_avx(
+    d: [&[f32]; 3],
+    sz: &[f32],
+    kz: &[u32],
+    s: [&mut [f32]; 2],
+    k: [&mut [u32]; 2],
+    n: usize,
+) -> usize {
+    use std::arch::x86_64::*;
+    let n = n / LANES * LANES;
+    let (zero, one, two) = (_mm256_setzero_si256(), _mm256_set1_epi32(1), _mm256_set1_epi32(2));
+    let next = |a: __m256i| _mm256_blendv_epi8(_mm256_add_epi32(a, one), zero, _mm256_cmpeq_epi32(a, two));
+    let mut j = 0;
+    while j < n {
+        // SAFETY: j + LANES <= n <= every array's length.
+        unsafe {
+            let (x, y, z) = (
+                _mm256_loadu_ps(d[0].as_ptr().add(j)),
+                _mm256_loadu_ps(d[1].as_ptr().add(j)),
+                _mm256_loadu_ps(d[2].as_ptr().add(j)),
+            );
+            let kzv = _mm256_loadu_si256(kz.as_ptr().add(j).cast());
+            let pick = |a: __m256i| {
+                let is0 = _mm256_castsi256_ps(_mm256_cmpeq_epi32(a, zero));
+                let is1 = _mm256_castsi256_ps(_mm256_cmpeq_epi32(a, one));
+                _mm256_blendv_ps(_mm256_blendv_ps(z, y, is1), x, is0)
+            };
+            let (a, b) = (next(kzv), next(next(kzv)));
+            let neg = _mm256_castps_si256(_mm256_cmp_ps::<_CMP_LT_OQ>(pick(kzv), _mm256_setzero_ps()));
+            let (kxv, kyv) = (_mm256_blendv_epi8(a, b, neg), _mm256_blendv_epi8(b, a, neg));
+            let szv = _mm256_loadu_ps(sz.as_ptr().add(j));
+            _mm256_storeu_ps(s[0].as_mut_ptr().add(j), _mm256_mul_ps(pick(kxv), szv));
+            _mm256_storeu_ps(s[1].as_mut_ptr().add(j), _mm256_mul_ps(pick(kyv), szv));
+            _mm256_storeu_si256(k[0].as_mut_ptr().add(j).cast(), kxv);
+            _mm256_storeu_si256(k[1].as_mut_ptr().add(j).cast(), kyv);
+        }
+        j += LANES;
+    }
+    n
+}
+
 /// The rays' inverse directions in lanes.
 pub(super) struct BoxLanes<'a> {
     pub(super) ix: &'a [f32],
@@ -322,6 +398,77 @@ unsafe fn misses_avx(s: &[Vec3; 3], span: &[(f32, f32); 3], lanes: &Lanes, maybe
     }
 }
 
+/// Per ray, in lanes, the watertight test's shear ([`crate::geometry::RayTest::shear`]).
+#[cfg(target_arch = "x86_64")]
+pub(super) struct Shear<'a> {
+    pub(super) s: [&'a [f32]; 3],
+    pub(super) k: [&'a [u32]; 3],
+}
+
+/// [`crate::geometry::RayTest::hit`] of the triangle with vertices `a`, `b`, `c` (relative to the
+/// rays' common origin) for the eight lanes `base..base + 8`, with `t` in
+/// `(SEGMENT_EPS, 1 - SEGMENT_EPS)`: the same IEEE operations in the same order, so the same answers.
+/// Returns the lanes hit and the lanes the scalar test must decide (an edge function exactly zero,
+/// which it recomputes in f64), as bits.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx,avx2")]
+pub(super) unsafe fn exact_avx(a: Vec3, b: Vec3, c: Vec3, shear: &Shear, base: usize) -> (u8, u8) {
+    use std::arch::x86_64::*;
+    let n = shear.s.iter().map(|v| v.len()).chain(shear.k.iter().map(|v| v.len())).min().unwrap_or(0);
+    assert!(base + LANES <= n, "lanes {base}.. of {n}");
+    // SAFETY: base + LANES <= n <= every array's length (checked above).
+    let (sx, sy, sz, kx, ky, kz) = unsafe {
+        (
+            _mm256_loadu_ps(shear.s[0].as_ptr().add(base)),
+            _mm256_loadu_ps(shear.s[1].as_ptr().add(base)),
+            _mm256_loadu_ps(shear.s[2].as_ptr().add(base)),
+            _mm256_loadu_si256(shear.k[0].as_ptr().add(base).cast()),
+            _mm256_loadu_si256(shear.k[1].as_ptr().add(base).cast()),
+            _mm256_loadu_si256(shear.k[2].as_ptr().add(base).cast()),
+        )
+    };
+    let sp = |v: f32| _mm256_set1_ps(v);
+    let (zero, one) = (_mm256_setzero_si256(), _mm256_set1_epi32(1));
+    // Per lane, component `k` of `v`.
+    let pick = |v: Vec3, k: __m256i| {
+        let is0 = _mm256_castsi256_ps(_mm256_cmpeq_epi32(k, zero));
+        let is1 = _mm256_castsi256_ps(_mm256_cmpeq_epi32(k, one));
+        _mm256_blendv_ps(_mm256_blendv_ps(sp(v.z), sp(v.y), is1), sp(v.x), is0)
+    };
+    let (mul, sub, add) = (|x, y| _mm256_mul_ps(x, y), |x, y| _mm256_sub_ps(x, y), |x, y| _mm256_add_ps(x, y));
+    let (akz, bkz, ckz) = (pick(a, kz), pick(b, kz), pick(c, kz));
+    let ax = sub(pick(a, kx), mul(sx, akz));
+    let ay = sub(pick(a, ky), mul(sy, akz));
+    let bx = sub(pick(b, kx), mul(sx, bkz));
+    let by = sub(pick(b, ky), mul(sy, bkz));
+    let cx = sub(pick(c, kx), mul(sx, ckz));
+    let cy = sub(pick(c, ky), mul(sy, ckz));
+    let u = sub(mul(cx, by), mul(cy, bx));
+    let v = sub(mul(ax, cy), mul(ay, cx));
+    let w = sub(mul(bx, ay), mul(by, ax));
+    let z = _mm256_setzero_ps();
+    let eq0 = |x| _mm256_cmp_ps::<_CMP_EQ_OQ>(x, z);
+    let scalar = _mm256_or_ps(_mm256_or_ps(eq0(u), eq0(v)), eq0(w));
+    let any = |f: fn(__m256, __m256) -> __m256| _mm256_or_ps(_mm256_or_ps(f(u, z), f(v, z)), f(w, z));
+    let neg = any(|x, z| _mm256_cmp_ps::<_CMP_LT_OQ>(x, z));
+    let pos = any(|x, z| _mm256_cmp_ps::<_CMP_GT_OQ>(x, z));
+    let det = add(add(u, v), w);
+    let sign = sp(-0.0);
+    let finite = _mm256_cmp_ps::<_CMP_LT_OQ>(_mm256_andnot_ps(sign, det), sp(f32::INFINITY));
+    let det_ok = _mm256_andnot_ps(eq0(det), finite);
+    let t_scaled = add(add(mul(u, mul(sz, akz)), mul(v, mul(sz, bkz))), mul(w, mul(sz, ckz)));
+    // Sign-corrected: negate both where `det < 0`.
+    let flip = _mm256_and_ps(_mm256_cmp_ps::<_CMP_LT_OQ>(det, z), sign);
+    let (ts, d) = (_mm256_xor_ps(t_scaled, flip), _mm256_xor_ps(det, flip));
+    let outside = _mm256_or_ps(
+        _mm256_cmp_ps::<_CMP_LE_OQ>(ts, mul(sp(SEGMENT_EPS), d)),
+        _mm256_cmp_ps::<_CMP_GE_OQ>(ts, mul(sp(1.0 - SEGMENT_EPS), d)),
+    );
+    let miss = _mm256_or_ps(_mm256_or_ps(_mm256_and_ps(neg, pos), outside), scalar);
+    let hit = _mm256_andnot_ps(miss, det_ok);
+    (_mm256_movemask_ps(hit) as u8, _mm256_movemask_ps(scalar) as u8)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -362,6 +509,94 @@ mod tests {
                 }
                 assert_eq!(kz[k], want_kz as u32, "ray {k} {d}");
             }
+        }
+    }
+
+    /// The shear lanes are [`crate::geometry::RayTest::new`]'s, bit for bit, on ordinary, tied,
+    /// signed and tiny components, in whole blocks and in the scalar tail.
+    #[test]
+    fn shear_lanes_match_the_ray_test() {
+        use crate::geometry::RayTest;
+        let special = [1.0, -1.0, 1e-30, -1e-38, 3e38, -2.5, 0.1, 7.0, -7.0, 0.0, -0.0];
+        let mut state = 13u64;
+        let mut rnd = || {
+            state = crate::render::sampler::mix64(state);
+            special[(state % special.len() as u64) as usize] * if state & 1 << 40 != 0 { 1.0 } else { 3.3 }
+        };
+        let n = 4093;
+        let d: Vec<Vec3> = (0..n).map(|_| Vec3::new(rnd(), rnd(), rnd())).filter(|d| *d != Vec3::ZERO).collect();
+        let n = d.len();
+        let tests: Vec<RayTest> = d.iter().map(|&d| RayTest::new(Vec3::ZERO, d, 0.0, 1.0)).collect();
+        let (dx, dy, dz): (Vec<f32>, Vec<f32>, Vec<f32>) = d.iter().map(|d| (d.x, d.y, d.z)).collect();
+        let sz: Vec<f32> = tests.iter().map(|t| t.shear().0[2]).collect();
+        let kz: Vec<u32> = tests.iter().map(|t| t.shear().1[2]).collect();
+        let (mut sx, mut sy, mut kx, mut ky) = (vec![0.0; n], vec![0.0; n], vec![0; n], vec![0; n]);
+        shear_lanes([&dx, &dy, &dz], &sz, &kz, [&mut sx, &mut sy], [&mut kx, &mut ky]);
+        for (j, t) in tests.iter().enumerate() {
+            let (s, k) = t.shear();
+            assert_eq!([sx[j].to_bits(), sy[j].to_bits()], [s[0].to_bits(), s[1].to_bits()], "ray {j} {}", d[j]);
+            assert_eq!([kx[j], ky[j]], [k[0], k[1]], "ray {j} {}", d[j]);
+        }
+    }
+
+    /// The eight-lane watertight test answers as [`crate::geometry::RayTest::hit`], lane by lane,
+    /// on random rays and triangles, and on rays through a triangle's vertices and edges and along
+    /// its plane (where edge functions come out zero and the scalar test must decide).
+    #[test]
+    fn lane_watertight_test_matches_the_scalar_one() {
+        #[cfg(target_arch = "x86_64")]
+        if std::arch::is_x86_feature_detected!("avx2") {
+            use crate::geometry::{RayTest, Triangle};
+            let mut rng = crate::render::sampler::Rng::stream(9, 0, 0, 0);
+            let mut v =
+                || Vec3::new(rng.next_f32() * 4.0 - 2.0, rng.next_f32() * 4.0 - 2.0, rng.next_f32() * 4.0 - 2.0);
+            let (mut hits, mut scalar, mut total) = (0, 0, 0);
+            for round in 0..4000 {
+                let x = if round % 4 == 0 { Vec3::ZERO } else { v() };
+                let tri = if round % 7 == 0 {
+                    // Flat in x's plane, or with a vertex at x.
+                    Triangle::new(x, v(), v())
+                } else {
+                    Triangle::new(v(), v(), v())
+                };
+                let targets: Vec<Vec3> = (0..LANES)
+                    .map(|j| match (round + j) % 5 {
+                        // Through a vertex, an edge's midpoint, the centroid, beyond it, or anywhere.
+                        0 => x + (tri.v[j % 3] - x) * 2.0,
+                        1 => x + ((tri.v[j % 3] + tri.v[(j + 1) % 3]) * 0.5 - x) * 1.5,
+                        2 => x + ((tri.v[0] + tri.v[1] + tri.v[2]) / 3.0 - x) * 3.0,
+                        3 => (tri.v[0] + tri.v[1] + tri.v[2]) / 3.0,
+                        _ => v(),
+                    })
+                    .collect();
+                let tests: Vec<RayTest> =
+                    targets.iter().map(|&y| RayTest::new(x, y - x, SEGMENT_EPS, 1.0 - SEGMENT_EPS)).collect();
+                let mut s: [Vec<f32>; 3] = Default::default();
+                let mut k: [Vec<u32>; 3] = Default::default();
+                for t in &tests {
+                    let (ts, tk) = t.shear();
+                    for i in 0..3 {
+                        s[i].push(ts[i]);
+                        k[i].push(tk[i]);
+                    }
+                }
+                let shear = Shear { s: [&s[0], &s[1], &s[2]], k: [&k[0], &k[1], &k[2]] };
+                let (a, b, c) = (tri.v[0] - x, tri.v[1] - x, tri.v[2] - x);
+                // SAFETY: AVX2 is available (checked above); eight lanes.
+                let (hit, to_scalar) = unsafe { exact_avx(a, b, c, &shear, 0) };
+                for (j, t) in tests.iter().enumerate() {
+                    total += 1;
+                    if to_scalar >> j & 1 != 0 {
+                        scalar += 1;
+                        continue;
+                    }
+                    let want = t.hit(&tri).is_some();
+                    assert_eq!(hit >> j & 1 != 0, want, "round {round} lane {j}: {tri:?} from {x} to {}", targets[j]);
+                    hits += usize::from(want);
+                }
+            }
+            // Hits, misses and lanes left to the scalar test all occur.
+            assert!(hits > 2000 && hits < total - 2000 && scalar > 100, "{hits} hits, {scalar} scalar of {total}");
         }
     }
 }

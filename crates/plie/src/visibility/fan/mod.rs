@@ -12,6 +12,12 @@
 //! finite — gets the exact [`blocks`](super::blocks) predicate. So each answer is the watertight
 //! test's, bit for bit, and the fast path only skips work.
 //!
+//! The watertight test itself runs eight rays wide where two or more rays of a block of eight need
+//! it ([`lanes::exact_avx`]): the same IEEE operations in the same order as
+//! [`RayTest::hit`](crate::geometry::RayTest::hit), so the same answers; a lane where an edge function
+//! comes out exactly zero (which the scalar test recomputes in f64) is left to the scalar test. With
+//! at most [`DIRECT_MAX`] rays to test, the edge test is skipped: it would cost more than it saves.
+//!
 //! A second cull rejects a triangle for all rays at once: the pyramid from `x` over the light polygon
 //! ([`Pyramid`]), grown by a margin, contains every segment; a triangle whose three vertices lie
 //! beyond one of its planes meets none of them.
@@ -28,7 +34,9 @@ mod lanes;
 
 #[cfg(target_arch = "x86_64")]
 use lanes::ray_lanes_avx;
-use lanes::{inverse, meets_boxes, misses, BoxLanes, Lanes};
+#[cfg(target_arch = "x86_64")]
+use lanes::{exact_avx, Shear};
+use lanes::{inverse, meets_boxes, misses, shear_lanes, BoxLanes, Lanes};
 
 /// Relative margin of the edge functions. The watertight test's sheared edge function of an edge
 /// `(p, q)` differs from the real `det(p, q, d) / d_kz` by at most about `32 ε |p| |q|` (the shear has
@@ -54,6 +62,10 @@ pub struct Fan {
     all_kz: Vec<u32>,
     /// The exact tests, built on first use: valid where bit `k` of `built` is set.
     tests: Vec<RayTest>,
+    /// Per ray, the rest of the watertight test's shear ([`RayTest::shear`]): `sx`, `sy` and the
+    /// axes `kx`, `ky` (`sz` and `kz` are in `all` and `all_kz`), padded to whole lanes.
+    shear_s: [Vec<f32>; 2],
+    shear_k: [Vec<u32>; 2],
     built: Vec<u64>,
     /// Bit `k` of word `k / 64`: ray `k` is still open (not found occluded).
     open: Vec<u64>,
@@ -118,6 +130,18 @@ impl Fan {
         if self.tests.len() < n {
             self.tests.resize(n, RayTest::new(Vec3::ZERO, Vec3::X, 0.0, 1.0));
         }
+        for v in &mut self.shear_s {
+            v.resize(padded, 0.0);
+        }
+        for v in &mut self.shear_k {
+            v.resize(padded, 0);
+        }
+        {
+            let [dx, dy, dz, _, sz, ..] = &self.all;
+            let [sx, sy] = &mut self.shear_s;
+            let [kx, ky] = &mut self.shear_k;
+            shear_lanes([&dx[..n], &dy[..n], &dz[..n]], &sz[..n], &self.all_kz[..n], [sx, sy], [kx, ky]);
+        }
         self.built.clear();
         self.built.resize(n.div_ceil(64), 0);
         // Every ray open.
@@ -132,31 +156,71 @@ impl Fan {
         self.live = n;
     }
 
-    /// The watertight test of `tri` for the rays `bits` of word `w`: each ray it blocks gets
-    /// `out[k]` set and is closed.
+    /// Builds the exact tests of the rays `bits` of word `w` that are not built yet.
     #[inline]
-    fn exact(
-        &mut self,
-        tri: &Triangle,
-        w: usize,
-        mut bits: u64,
-        rays: &LightRays,
-        out: &mut [bool],
-        ctx: &mut QueryCtx,
-    ) {
-        while bits != 0 {
-            let k = w * 64 + bits.trailing_zeros() as usize;
-            bits &= bits - 1;
-            if self.built[k / 64] & (1 << (k % 64)) == 0 {
-                self.tests[k] = rays.ray(k).test;
-                self.built[k / 64] |= 1 << (k % 64);
+    fn build(&mut self, w: usize, bits: u64, rays: &LightRays) {
+        let mut todo = bits & !self.built[w];
+        self.built[w] |= todo;
+        while todo != 0 {
+            let k = w * 64 + todo.trailing_zeros() as usize;
+            todo &= todo - 1;
+            self.tests[k] = rays.ray(k).test;
+            debug_assert_eq!(
+                self.tests[k].shear(),
+                (
+                    [self.shear_s[0][k], self.shear_s[1][k], self.all[4][k]],
+                    [self.shear_k[0][k], self.shear_k[1][k], self.all_kz[k]]
+                )
+            );
+        }
+    }
+
+    /// The watertight test of `tri` for the rays `bits` of word `w`: each ray it blocks gets
+    /// `out[k]` set and is closed. Blocks of eight rays with two or more to test take the
+    /// lane-wide copy of the test ([`lanes::exact_avx`]), which answers as it does.
+    #[inline]
+    fn exact(&mut self, tri: &Triangle, w: usize, bits: u64, rays: &LightRays, out: &mut [bool], ctx: &mut QueryCtx) {
+        if bits == 0 {
+            return;
+        }
+        ctx.stats.triangle_tests += u64::from(bits.count_ones());
+        let mut one_by_one = bits;
+        let mut hits = 0u64;
+        #[cfg(target_arch = "x86_64")]
+        if bits.count_ones() >= 2 && std::arch::is_x86_feature_detected!("avx2") {
+            let x = self.origin;
+            let (a, b, c) = (tri.v[0] - x, tri.v[1] - x, tri.v[2] - x);
+            let [sx, sy] = &self.shear_s;
+            let [kx, ky] = &self.shear_k;
+            let shear = Shear { s: [sx, sy, &self.all[4]], k: [kx, ky, &self.all_kz] };
+            one_by_one = 0;
+            for block in 0..64 / LANES {
+                let byte = bits >> (block * LANES) & 0xff;
+                if byte.count_ones() < 2 {
+                    one_by_one |= byte << (block * LANES);
+                    continue;
+                }
+                // SAFETY: AVX2 is available (checked above); the shear lanes are padded to whole
+                // blocks.
+                let (hit, scalar) = unsafe { exact_avx(a, b, c, &shear, w * 64 + block * LANES) };
+                hits |= (u64::from(hit) & byte) << (block * LANES);
+                one_by_one |= (u64::from(scalar) & byte) << (block * LANES);
             }
-            ctx.stats.triangle_tests += 1;
-            if self.tests[k].hit(tri).is_some() {
-                self.open[w] &= !(1u64 << (k % 64));
-                self.live -= 1;
-                out[k] = true;
+        }
+        self.build(w, one_by_one, rays);
+        while one_by_one != 0 {
+            let i = one_by_one.trailing_zeros() as usize;
+            one_by_one &= one_by_one - 1;
+            if self.tests[w * 64 + i].hit(tri).is_some() {
+                hits |= 1 << i;
             }
+        }
+        self.open[w] &= !hits;
+        self.live -= hits.count_ones() as usize;
+        while hits != 0 {
+            let i = hits.trailing_zeros() as usize;
+            hits &= hits - 1;
+            out[w * 64 + i] = true;
         }
     }
 
@@ -214,8 +278,8 @@ impl Fan {
         hit
     }
 
-    /// [`Fan::test`] for the open lanes of `within` only: a few lanes go straight to the watertight
-    /// test, more first through the eight-lane edge test.
+    /// [`Fan::test`] for the open lanes of `within` only: up to [`DIRECT_MAX`] lanes go straight to
+    /// the watertight test, more first through the eight-lane edge test.
     #[inline]
     pub fn test_within(
         &mut self,
@@ -245,11 +309,19 @@ impl Fan {
     }
 
     /// Tests triangle `t` against the open rays: each ray `k` it blocks gets `out[k]` set and
-    /// is closed. Counts a lane test per open ray, and a triangle test per watertight test. The caller has excluded the rays' own
-    /// triangles (the origin's and the light's).
+    /// is closed. Up to [`DIRECT_MAX`] open rays go straight to the watertight test. Counts a lane
+    /// test per open ray through the edge test, and a triangle test per ray given the watertight
+    /// test. The caller has excluded the rays' own triangles (the origin's and the light's).
     #[inline]
     pub fn test(&mut self, scene: &Scene, rays: &LightRays, t: TriId, out: &mut [bool], ctx: &mut QueryCtx) {
-        self.test_masked(scene, rays, t, None, out, ctx);
+        if self.live as u32 <= DIRECT_MAX {
+            let tri = &scene.triangles[t.idx()];
+            for w in 0..self.open.len() {
+                self.exact(tri, w, self.open[w], rays, out, ctx);
+            }
+        } else {
+            self.test_masked(scene, rays, t, None, out, ctx);
+        }
     }
 
     /// [`Fan::test`], for the open lanes of `within` only when given.
@@ -296,8 +368,11 @@ impl Fan {
     }
 }
 
-/// At most this many lanes of [`Fan::test_within`] go straight to the watertight test.
-const DIRECT_MAX: u32 = 3;
+/// At most this many rays of a triangle test go straight to the watertight test, without the edge
+/// test first. Measured (callgrind of the query at 64 rays on cornell-cube-2, huis-c, dragon,
+/// cornell-bunny and conference-lit, docs/results.md session 9): 16 to 32 needed the fewest
+/// instructions of 3, 8, 16, 24, 32 and 64 once the watertight test ran eight rays wide (3 did before).
+const DIRECT_MAX: u32 = 16;
 
 /// Per-thread scratch of the per-light queries ([`super::Visibility::occluded_light`]).
 #[derive(Clone, Debug, Default)]
