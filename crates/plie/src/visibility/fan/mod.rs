@@ -187,24 +187,24 @@ impl Fan {
         let mut one_by_one = bits;
         let mut hits = 0u64;
         #[cfg(target_arch = "x86_64")]
-        if bits.count_ones() >= 2 && std::arch::is_x86_feature_detected!("avx2") {
+        if std::arch::is_x86_feature_detected!("avx2") {
             let x = self.origin;
             let (a, b, c) = (tri.v[0] - x, tri.v[1] - x, tri.v[2] - x);
             let [sx, sy] = &self.shear_s;
             let [kx, ky] = &self.shear_k;
             let shear = Shear { s: [sx, sy, &self.all[4]], k: [kx, ky, &self.all_kz] };
             one_by_one = 0;
-            for block in 0..64 / LANES {
-                let byte = bits >> (block * LANES) & 0xff;
-                if byte.count_ones() < 2 {
-                    one_by_one |= byte << (block * LANES);
-                    continue;
-                }
+            // The blocks of eight rays with a ray to test.
+            let mut rest = bits;
+            while rest != 0 {
+                let at = rest.trailing_zeros() as usize / LANES * LANES;
+                let byte = rest >> at & 0xff;
+                rest &= !(0xff << at);
                 // SAFETY: AVX2 is available (checked above); the shear lanes are padded to whole
                 // blocks.
-                let (hit, scalar) = unsafe { exact_avx(a, b, c, &shear, w * 64 + block * LANES) };
-                hits |= (u64::from(hit) & byte) << (block * LANES);
-                one_by_one |= (u64::from(scalar) & byte) << (block * LANES);
+                let (hit, scalar) = unsafe { exact_avx(a, b, c, &shear, w * 64 + at) };
+                hits |= (u64::from(hit) & byte) << at;
+                one_by_one |= (u64::from(scalar) & byte) << at;
             }
         }
         self.build(w, one_by_one, rays);
