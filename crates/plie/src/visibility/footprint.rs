@@ -35,6 +35,18 @@ pub fn footprints(bounds: &Aabb, x: Vec3, light: &[Vec3], eps: f32, out: &mut Ve
     let scale = light.iter().fold(x.abs().max_element(), |m, v| m.max(v.abs().max_element())) as f64;
     let margin = 1e-5 * scale.max(f64::MIN_POSITIVE);
     let (lo, hi) = (bounds.min.as_dvec3(), bounds.max.as_dvec3());
+    // The light's vertices in f64, once (on the stack for up to eight).
+    let mut stack = [DVec3::ZERO; 8];
+    let heap: Vec<DVec3>;
+    let pv: &[DVec3] = if light.len() <= stack.len() {
+        for (d, p) in stack.iter_mut().zip(light) {
+            *d = p.as_dvec3();
+        }
+        &stack[..light.len()]
+    } else {
+        heap = light.iter().map(|p| p.as_dvec3()).collect();
+        &heap
+    };
     let mut all_exit = false;
     for k in 0..3 {
         let (u, v) = ((k + 1) % 3, (k + 2) % 3);
@@ -42,32 +54,33 @@ pub fn footprints(bounds: &Aabb, x: Vec3, light: &[Vec3], eps: f32, out: &mut Ve
             let w = if positive { hi[k] } else { lo[k] };
             // Signed distance beyond the face plane, away from x.
             let beyond = |p: DVec3| if positive { p[k] - w } else { w - p[k] };
-            if light.iter().all(|p| beyond(p.as_dvec3()) <= margin) {
+            let (least, most) =
+                pv.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &p| (a.min(beyond(p)), b.max(beyond(p))));
+            if most <= margin {
                 // No light point lies clearly beyond this plane: a segment may still reach it
                 // within rounding; it is counted as crossing the whole face only if some vertex
                 // is not clearly inside.
-                if light.iter().all(|p| beyond(p.as_dvec3()) < -margin) {
+                if most < -margin {
                     continue;
                 }
                 out.push(FaceFootprint { face: Dir::from_axis(k, positive), rect: [lo[u], hi[u], lo[v], hi[v]] });
                 continue;
             }
-            let strictly = light.iter().all(|p| beyond(p.as_dvec3()) > margin);
-            let rect = if strictly {
+            let rect = if least > margin {
                 // Every segment crosses the plane: the cross-section is the projection of the polygon.
                 let h = beyond(xd).abs();
                 let mut r = [f64::INFINITY, f64::NEG_INFINITY, f64::INFINITY, f64::NEG_INFINITY];
-                for p in light {
-                    let p = p.as_dvec3();
+                // Every segment leaves the box at the latest where it crosses this plane, at
+                // parameter s <= max over vertices (the parameter is monotone along the polygon's
+                // points, being h / (h + beyond) with beyond affine).
+                let mut s_max = 0.0f64;
+                for &p in pv {
                     // The point of the segment x -> p on the plane.
                     let s = h / (h + beyond(p));
                     let q = xd + (p - xd) * s;
                     r = [r[0].min(q[u]), r[1].max(q[u]), r[2].min(q[v]), r[3].max(q[v])];
+                    s_max = s_max.max(s);
                 }
-                // Every segment leaves the box at the latest where it crosses this plane, at
-                // parameter s <= max over vertices (the parameter is monotone along the polygon's
-                // points, being h / (h + beyond) with beyond affine).
-                let s_max = light.iter().map(|p| h / (h + beyond(p.as_dvec3()))).fold(0.0, f64::max);
                 if s_max < 1.0 - 4.0 * eps as f64 {
                     all_exit = true;
                 }

@@ -41,6 +41,7 @@ impl Pyramid {
         }
         // The sample domain's hull is the polygon (plus, for a parallelogram, its fourth corner
         // recomputed, within rounding of the vertex): the polygon's edges, grown by the margin.
+        let toward_centre = light.center() - x;
         for i in 0..v.len() {
             let (p, q) = (v[i] - x, v[(i + 1) % v.len()] - x);
             // The plane through the apex and the edge (p, q), its normal turned toward the centre.
@@ -51,7 +52,7 @@ impl Pyramid {
                 return false;
             }
             let mut s = s / len;
-            if s.dot(light.center() - x) < 0.0 {
+            if s.dot(toward_centre) < 0.0 {
                 s = -s;
             }
             self.sides.push(s);
