@@ -83,10 +83,21 @@ impl Fan {
         let x = rays.origin;
         let n = rays.targets.len();
         self.origin = x;
-        for v in &mut self.all {
-            v.resize(n, 0.0);
+        let padded = n.div_ceil(LANES) * LANES;
+        let words = n.div_ceil(64);
+        // A render asks the same number of samples every time: the arrays keep their length.
+        if self.tests.len() != n || self.all_kz.len() != padded {
+            for v in self.all.iter_mut().chain(&mut self.shear_s) {
+                v.resize(padded, 0.0);
+            }
+            for v in std::iter::once(&mut self.all_kz).chain(&mut self.shear_k) {
+                v.resize(padded, 0);
+            }
+            self.tests.resize(n, RayTest::new(Vec3::ZERO, Vec3::X, 0.0, 1.0));
+            self.built.resize(words, 0);
+            self.open.resize(words, 0);
+            self.maybe.resize(words, 0);
         }
-        self.all_kz.resize(n, 0);
         let [dx, dy, dz, len, sz, ix, iy, iz] = &mut self.all;
         for (k, y) in rays.targets.iter().enumerate() {
             let d = *y - x;
@@ -121,38 +132,28 @@ impl Fan {
             kzs[k] = kz as u32;
             sz[k] = 1.0 / d[kz];
         }
-        // The padding lanes: zero (a zero direction meets no box and no triangle's cone).
-        let padded = n.div_ceil(LANES) * LANES;
-        for v in &mut self.all {
-            v.resize(padded, 0.0);
-        }
-        self.all_kz.resize(padded, 0);
-        if self.tests.len() < n {
-            self.tests.resize(n, RayTest::new(Vec3::ZERO, Vec3::X, 0.0, 1.0));
-        }
-        for v in &mut self.shear_s {
-            v.resize(padded, 0.0);
-        }
-        for v in &mut self.shear_k {
-            v.resize(padded, 0);
-        }
         {
             let [dx, dy, dz, _, sz, ..] = &self.all;
             let [sx, sy] = &mut self.shear_s;
             let [kx, ky] = &mut self.shear_k;
             shear_lanes([&dx[..n], &dy[..n], &dz[..n]], &sz[..n], &self.all_kz[..n], [sx, sy], [kx, ky]);
         }
-        self.built.clear();
-        self.built.resize(n.div_ceil(64), 0);
+        // The padding lanes: zero (a zero direction meets no box and no triangle's cone).
+        if padded > n {
+            for v in self.all.iter_mut().chain(&mut self.shear_s) {
+                v[n..].fill(0.0);
+            }
+            for v in std::iter::once(&mut self.all_kz).chain(&mut self.shear_k) {
+                v[n..].fill(0);
+            }
+        }
+        self.built.fill(0);
         // Every ray open.
-        let words = n.div_ceil(64);
-        self.open.clear();
-        self.open.resize(words, u64::MAX);
+        self.open.fill(u64::MAX);
         if n % 64 != 0 {
             self.open[words - 1] = (1u64 << (n % 64)) - 1;
         }
-        self.maybe.clear();
-        self.maybe.resize(words, 0);
+        self.maybe.fill(0);
         self.live = n;
     }
 
