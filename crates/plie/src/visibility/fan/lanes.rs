@@ -643,7 +643,8 @@ mod tests {
             special[(state % special.len() as u64) as usize] * if state & 1 << 40 != 0 { 1.0 } else { 3.3 }
         };
         let n = 4093;
-        let d: Vec<Vec3> = (0..n).map(|_| Vec3::new(rnd(), rnd(), rnd())).filter(|d| *d != Vec3::ZERO).collect();
+        let d: Vec<Vec3> =
+            (0..n).map(|_| Vec3::new(rnd(), rnd(), rnd())).filter(|d| d.is_finite() && *d != Vec3::ZERO).collect();
         let n = d.len();
         let tests: Vec<RayTest> = d.iter().map(|&d| RayTest::new(Vec3::ZERO, d, 0.0, 1.0)).collect();
         let (dx, dy, dz): (Vec<f32>, Vec<f32>, Vec<f32>) = d.iter().map(|d| (d.x, d.y, d.z)).collect();
@@ -687,6 +688,8 @@ mod tests {
                         3 => (tri.v[0] + tri.v[1] + tri.v[2]) / 3.0,
                         _ => v(),
                     })
+                    // A ray needs a direction (a vertex at x sends "through the vertex" nowhere).
+                    .map(|y| if y == x { x + Vec3::ONE } else { y })
                     .collect();
                 let tests: Vec<RayTest> =
                     targets.iter().map(|&y| RayTest::new(x, y - x, SEGMENT_EPS, 1.0 - SEGMENT_EPS)).collect();
