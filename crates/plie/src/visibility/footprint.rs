@@ -25,11 +25,17 @@ pub struct FaceFootprint {
 }
 
 /// The footprints of the segments from `x` (inside `bounds`) to the convex polygon `light` on the
-/// faces of `bounds`, into `out`. Returns whether every such segment certainly leaves the box before
-/// its parameter `1 - 2 eps` (`eps` the segments' end tolerance), that is, whether no sample's ray
-/// can end inside the leaf.
-pub fn footprints(bounds: &Aabb, x: Vec3, light: &[Vec3], eps: f32, out: &mut Vec<FaceFootprint>) -> bool {
-    out.clear();
+/// faces of `bounds`, each handed to `visit` as it is found; `visit` returns false to stop. Returns
+/// `None` if it stopped, else whether every such segment certainly leaves the box before its
+/// parameter `1 - 2 eps` (`eps` the segments' end tolerance), that is, whether no sample's ray can
+/// end inside the leaf.
+pub fn footprints(
+    bounds: &Aabb,
+    x: Vec3,
+    light: &[Vec3],
+    eps: f32,
+    mut visit: impl FnMut(FaceFootprint) -> bool,
+) -> Option<bool> {
     let xd = x.as_dvec3();
     // The margin: relative to the coordinates involved, far above f32 rounding (~6e-8 relative).
     let scale = light.iter().fold(x.abs().max_element(), |m, v| m.max(v.abs().max_element())) as f64;
@@ -47,6 +53,9 @@ pub fn footprints(bounds: &Aabb, x: Vec3, light: &[Vec3], eps: f32, out: &mut Ve
         heap = light.iter().map(|p| p.as_dvec3()).collect();
         &heap
     };
+    // Plain comparisons: every value here is finite (`f64::min` would also handle NaN).
+    let min = |a: f64, b: f64| if b < a { b } else { a };
+    let max = |a: f64, b: f64| if b > a { b } else { a };
     let mut all_exit = false;
     for k in 0..3 {
         let (u, v) = ((k + 1) % 3, (k + 2) % 3);
@@ -55,7 +64,7 @@ pub fn footprints(bounds: &Aabb, x: Vec3, light: &[Vec3], eps: f32, out: &mut Ve
             // Signed distance beyond the face plane, away from x.
             let beyond = |p: DVec3| if positive { p[k] - w } else { w - p[k] };
             let (least, most) =
-                pv.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &p| (a.min(beyond(p)), b.max(beyond(p))));
+                pv.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &p| (min(a, beyond(p)), max(b, beyond(p))));
             if most <= margin {
                 // No light point lies clearly beyond this plane: a segment may still reach it
                 // within rounding; it is counted as crossing the whole face only if some vertex
@@ -63,7 +72,9 @@ pub fn footprints(bounds: &Aabb, x: Vec3, light: &[Vec3], eps: f32, out: &mut Ve
                 if most < -margin {
                     continue;
                 }
-                out.push(FaceFootprint { face: Dir::from_axis(k, positive), rect: [lo[u], hi[u], lo[v], hi[v]] });
+                if !visit(FaceFootprint { face: Dir::from_axis(k, positive), rect: [lo[u], hi[u], lo[v], hi[v]] }) {
+                    return None;
+                }
                 continue;
             }
             let rect = if least > margin {
@@ -78,8 +89,8 @@ pub fn footprints(bounds: &Aabb, x: Vec3, light: &[Vec3], eps: f32, out: &mut Ve
                     // The point of the segment x -> p on the plane.
                     let s = h / (h + beyond(p));
                     let q = xd + (p - xd) * s;
-                    r = [r[0].min(q[u]), r[1].max(q[u]), r[2].min(q[v]), r[3].max(q[v])];
-                    s_max = s_max.max(s);
+                    r = [min(r[0], q[u]), max(r[1], q[u]), min(r[2], q[v]), max(r[3], q[v])];
+                    s_max = max(s_max, s);
                 }
                 if s_max < 1.0 - 4.0 * eps as f64 {
                     all_exit = true;
@@ -93,12 +104,15 @@ pub fn footprints(bounds: &Aabb, x: Vec3, light: &[Vec3], eps: f32, out: &mut Ve
             } else {
                 [lo[u], hi[u], lo[v], hi[v]]
             };
-            if rect[0] <= rect[1] && rect[2] <= rect[3] {
-                out.push(FaceFootprint { face: Dir::from_axis(k, positive), rect });
+            if rect[0] <= rect[1]
+                && rect[2] <= rect[3]
+                && !visit(FaceFootprint { face: Dir::from_axis(k, positive), rect })
+            {
+                return None;
             }
         }
     }
-    all_exit
+    Some(all_exit)
 }
 
 #[cfg(test)]
@@ -121,7 +135,12 @@ mod tests {
             let c = Vec3::new(rnd() * 6.0 - 2.5, rnd() * 3.0 + 0.2 + (case % 3) as f32, rnd() * 6.0 - 2.5);
             let (e1, e2) = (Vec3::new(rnd(), 0.0, rnd() * 0.3), Vec3::new(rnd() * 0.3, rnd() * 0.2, rnd()));
             let light = [c, c + e1, c + e1 + e2, c + e2];
-            let all_exit = footprints(&bounds, x, &light, 1e-4, &mut out);
+            out.clear();
+            let all_exit = footprints(&bounds, x, &light, 1e-4, |f| {
+                out.push(f);
+                true
+            })
+            .expect("not stopped");
             for _ in 0..64 {
                 let (a, b) = (rnd(), rnd());
                 let y = c + e1 * a + e2 * b;

@@ -382,8 +382,6 @@ pub struct LightScratch {
     pub fan: Fan,
     /// The distinct blocker lists of the current (point, light): the mode's own keys.
     pub lists: Vec<u32>,
-    /// The light's footprints on the leaf's faces.
-    pub feet: Vec<super::footprint::FaceFootprint>,
     /// The `(start, len)` of the face-grid cell lists gathered in `lists` (to keep each list once).
     pub ranges: Vec<(u32, u32)>,
     /// The stack of a walk down the scene BVH.

@@ -75,19 +75,18 @@ impl LieVisibility<'_> {
         poly: &[Vec3],
         sc: &mut LightScratch,
     ) -> Whole {
-        let all_exit = footprints(bounds, rays.origin, poly, SEGMENT_EPS, &mut sc.feet);
-        let (mut lit, mut umbra, mut listed) = (true, all_exit, self.mode == Mode::Grid);
+        // `umbra`: every footprint so far lies in umbra cells or on a face without a record (the
+        // samples' rays must also all leave the leaf).
+        let (mut lit, mut umbra, mut listed) = (true, true, self.mode == Mode::Grid);
         // Triangles in the distinct lists gathered so far.
         let mut gathered = 0;
-        for f in 0..sc.feet.len() {
-            let fp = sc.feet[f];
+        // Each footprint as it is found; once none of the verdicts can hold, the rest are not
+        // computed.
+        let all_exit = footprints(bounds, rays.origin, poly, SEGMENT_EPS, |fp| {
             let Some(ri) = self.plie.record_id(leaf, fp.face, rays.light) else {
                 lit = false;
                 listed = false;
-                if !umbra {
-                    return Whole::Mixed;
-                }
-                continue;
+                return umbra;
             };
             let record = &self.plie.records[ri];
             match self.sat_start.get(ri).copied().filter(|&s| s != u32::MAX) {
@@ -122,10 +121,12 @@ impl LieVisibility<'_> {
                     }
                 }
             }
-            if !lit && !umbra && !listed {
-                return Whole::Mixed;
-            }
-        }
+            lit || umbra || listed
+        });
+        let Some(all_exit) = all_exit else {
+            return Whole::Mixed;
+        };
+        let umbra = umbra && all_exit;
         if umbra {
             Whole::Umbra
         } else if lit {
