@@ -5,7 +5,8 @@
 //!
 //! A node's eight child boxes are first culled by the pyramid from the point over the light
 //! ([`crate::visibility::pyramid::Pyramid::culls_rel8`]), then each is tested against every ray
-//! still in the node's mask, eight lanes at a time ([`Fan::meets8`]); a leaf's triangles are tested
+//! still in the node's mask, eight rays at a time, or one ray against all eight boxes where the
+//! node's rays are few and spread out ([`Fan::meets8`]); a leaf's triangles are tested
 //! against the rays that met its box ([`Fan::test_within`]). Inner children are visited nearest
 //! first (along the first sample's direction), so that blockers close the rays early.
 //!

@@ -1,7 +1,8 @@
-//! The fan's lane kernels (issue 21): per-ray values of a fan, the slab test of a box and the
-//! edge-function test of a triangle, eight lanes at a time with AVX2 and lane by lane otherwise. Each
-//! kernel computes exactly what its scalar form does, or only proves what the exact test would decide
-//! (see [`super`]).
+//! The fan's lane kernels (issue 21): per-ray values of a fan (its shears for the watertight test
+//! among them), the slab test of a box (eight rays against one box, or one ray against eight
+//! boxes), the edge-function test of a triangle and the watertight test itself, eight lanes at a
+//! time with AVX2 and lane by lane otherwise. Each kernel computes exactly what its scalar form
+//! does, or only proves what the exact test would decide (see [`super`]).
 
 use glam::Vec3;
 

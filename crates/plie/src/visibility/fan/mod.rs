@@ -245,8 +245,9 @@ impl Fan {
 
     /// For each box `c` of eight with bit `c` of `alive` set, given relative to the apex as lanes
     /// (`lo[axis][c]`, `hi[axis][c]`): `to[c * w..(c + 1) * w]` (`w` = [`Fan::words`]) becomes the
-    /// open rays of `within` whose segments meet it, by the slab test (eight rays at a time; it never
-    /// drops a ray whose segment meets the box). Returns the boxes some ray meets, as bits. Counts a
+    /// open rays of `within` whose segments meet it, by the slab test (eight rays at a time, or one
+    /// ray against the eight boxes where that is cheaper; it never drops a ray whose segment meets
+    /// the box). Returns the boxes some ray meets, as bits. Counts a
     /// box test per ray and box tested.
     #[inline]
     pub fn meets8(
