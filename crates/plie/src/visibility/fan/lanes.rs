@@ -76,6 +76,45 @@ pub(super) unsafe fn ray_lanes_avx(d: [&[f32]; 3], out: [&mut [f32]; 5], kz: &mu
     n
 }
 
+/// Per lane, `v[k]` for the lane's axis `k` (0, 1 or 2).
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx,avx2")]
+#[inline]
+unsafe fn by_axis(k: std::arch::x86_64::__m256i, v: [std::arch::x86_64::__m256; 3]) -> std::arch::x86_64::__m256 {
+    use std::arch::x86_64::*;
+    let is0 = _mm256_castsi256_ps(_mm256_cmpeq_epi32(k, _mm256_setzero_si256()));
+    let is1 = _mm256_castsi256_ps(_mm256_cmpeq_epi32(k, _mm256_set1_epi32(1)));
+    _mm256_blendv_ps(_mm256_blendv_ps(v[2], v[1], is1), v[0], is0)
+}
+
+/// The slab test of [`meets_box`] for eight (segment, box) pairs in lanes: the segments from the
+/// apex with inverse directions `inv` (parameter range `[SEGMENT_EPS, 1 - SEGMENT_EPS]`) against the
+/// boxes `[lo, hi]` given relative to the apex. Returns the lanes that meet, as bits. Both the
+/// eight-rays and the eight-boxes kernels run this, so they answer alike.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx,avx2")]
+#[inline]
+unsafe fn slab_avx(
+    lo: [std::arch::x86_64::__m256; 3],
+    hi: [std::arch::x86_64::__m256; 3],
+    inv: [std::arch::x86_64::__m256; 3],
+) -> u32 {
+    use std::arch::x86_64::*;
+    let (t_min, t_max) = (_mm256_set1_ps(SEGMENT_EPS), _mm256_set1_ps(1.0 - SEGMENT_EPS));
+    let (ax, cx) = (_mm256_mul_ps(lo[0], inv[0]), _mm256_mul_ps(hi[0], inv[0]));
+    let (ay, cy) = (_mm256_mul_ps(lo[1], inv[1]), _mm256_mul_ps(hi[1], inv[1]));
+    let (az, cz) = (_mm256_mul_ps(lo[2], inv[2]), _mm256_mul_ps(hi[2], inv[2]));
+    let t0 = _mm256_max_ps(
+        _mm256_max_ps(_mm256_min_ps(ax, cx), _mm256_min_ps(ay, cy)),
+        _mm256_max_ps(_mm256_min_ps(az, cz), t_min),
+    );
+    let t1 = _mm256_min_ps(
+        _mm256_min_ps(_mm256_max_ps(ax, cx), _mm256_max_ps(ay, cy)),
+        _mm256_min_ps(_mm256_max_ps(az, cz), t_max),
+    );
+    _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(t0, t1)) as u32
+}
+
 /// The rest of each ray's shear for the watertight test, as [`crate::geometry::RayTest::new`]
 /// computes it from the direction `d`, `sz = 1 / d[kz]` and `kz`: the axes `kx = kz + 1`, `ky = kx + 1`
 /// (mod 3, swapped where `d[kz] < 0`) and `sx = d[kx] sz`, `sy = d[ky] sz`, into `s` and `k`. Eight
@@ -133,11 +172,7 @@ unsafe fn shear_lanes_avx(
                 _mm256_loadu_ps(d[2].as_ptr().add(j)),
             );
             let kzv = _mm256_loadu_si256(kz.as_ptr().add(j).cast());
-            let pick = |a: __m256i| {
-                let is0 = _mm256_castsi256_ps(_mm256_cmpeq_epi32(a, zero));
-                let is1 = _mm256_castsi256_ps(_mm256_cmpeq_epi32(a, one));
-                _mm256_blendv_ps(_mm256_blendv_ps(z, y, is1), x, is0)
-            };
+            let pick = |a: __m256i| by_axis(a, [x, y, z]);
             let (a, b) = (next(kzv), next(next(kzv)));
             let neg = _mm256_castps_si256(_mm256_cmp_ps::<_CMP_LT_OQ>(pick(kzv), _mm256_setzero_ps()));
             let (kxv, kyv) = (_mm256_blendv_epi8(a, b, neg), _mm256_blendv_epi8(b, a, neg));
@@ -230,7 +265,7 @@ fn each_box(lo: &[[f32; 8]; 3], hi: &[[f32; 8]; 3], alive: u8, out: &mut [u64; 8
 
 /// [`meets_boxes`] with the eight boxes in lanes and one ray at a time: cheaper than eight rays
 /// at a time when the rays of `within` are few and spread over many blocks of eight. Each (ray, box)
-/// is decided by the same operations as in [`meets_box_avx`], so with the same answer.
+/// is decided by [`slab_avx`], as in [`meets_box_avx`], so with the same answer.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx,avx2")]
 pub(super) unsafe fn meets_boxes_by_ray_avx(
@@ -258,25 +293,14 @@ pub(super) unsafe fn meets_boxes_by_ray_avx(
             _mm256_loadu_ps(hi[2].as_ptr()),
         )
     };
-    let (t_min, t_max) = (_mm256_set1_ps(SEGMENT_EPS), _mm256_set1_ps(1.0 - SEGMENT_EPS));
     let mut bits = within;
     while bits != 0 {
         let b = bits.trailing_zeros() as usize;
         bits &= bits - 1;
         let j = base + b;
-        let (ix, iy, iz) = (_mm256_set1_ps(lanes.ix[j]), _mm256_set1_ps(lanes.iy[j]), _mm256_set1_ps(lanes.iz[j]));
-        let (ax, cx) = (_mm256_mul_ps(lx, ix), _mm256_mul_ps(hx, ix));
-        let (ay, cy) = (_mm256_mul_ps(ly, iy), _mm256_mul_ps(hy, iy));
-        let (az, cz) = (_mm256_mul_ps(lz, iz), _mm256_mul_ps(hz, iz));
-        let t0 = _mm256_max_ps(
-            _mm256_max_ps(_mm256_min_ps(ax, cx), _mm256_min_ps(ay, cy)),
-            _mm256_max_ps(_mm256_min_ps(az, cz), t_min),
-        );
-        let t1 = _mm256_min_ps(
-            _mm256_min_ps(_mm256_max_ps(ax, cx), _mm256_max_ps(ay, cy)),
-            _mm256_min_ps(_mm256_max_ps(az, cz), t_max),
-        );
-        let mut m = _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(t0, t1)) as u32 & u32::from(alive);
+        let inv = [_mm256_set1_ps(lanes.ix[j]), _mm256_set1_ps(lanes.iy[j]), _mm256_set1_ps(lanes.iz[j])];
+        // SAFETY: AVX2 is enabled here.
+        let mut m = unsafe { slab_avx([lx, ly, lz], [hx, hy, hz], inv) } & u32::from(alive);
         while m != 0 {
             let c = m.trailing_zeros() as usize;
             m &= m - 1;
@@ -308,8 +332,7 @@ unsafe fn meets_boxes_avx(
 unsafe fn meets_box_avx(lo: Vec3, hi: Vec3, lanes: &BoxLanes, base: usize, within: u64) -> u64 {
     use std::arch::x86_64::*;
     let sp = |v: f32| _mm256_set1_ps(v);
-    let (lx, ly, lz, hx, hy, hz) = (sp(lo.x), sp(lo.y), sp(lo.z), sp(hi.x), sp(hi.y), sp(hi.z));
-    let (t_min, t_max) = (sp(SEGMENT_EPS), sp(1.0 - SEGMENT_EPS));
+    let (lo, hi) = ([sp(lo.x), sp(lo.y), sp(lo.z)], [sp(hi.x), sp(hi.y), sp(hi.z)]);
     let n = lanes.ix.len().min(lanes.iy.len()).min(lanes.iz.len());
     let mut out = 0u64;
     let mut block = 0;
@@ -317,26 +340,15 @@ unsafe fn meets_box_avx(lo: Vec3, hi: Vec3, lanes: &BoxLanes, base: usize, withi
         let byte = (within >> (block * 8)) & 0xff;
         let j = base + block * LANES;
         if byte != 0 && j + LANES <= n {
-            // SAFETY: j + LANES <= n <= every array's length.
-            let (ix, iy, iz) = unsafe {
-                (
+            // SAFETY: j + LANES <= n <= every array's length; AVX2 is enabled here.
+            let m = unsafe {
+                let inv = [
                     _mm256_loadu_ps(lanes.ix.as_ptr().add(j)),
                     _mm256_loadu_ps(lanes.iy.as_ptr().add(j)),
                     _mm256_loadu_ps(lanes.iz.as_ptr().add(j)),
-                )
+                ];
+                u64::from(slab_avx(lo, hi, inv))
             };
-            let (ax, cx) = (_mm256_mul_ps(lx, ix), _mm256_mul_ps(hx, ix));
-            let (ay, cy) = (_mm256_mul_ps(ly, iy), _mm256_mul_ps(hy, iy));
-            let (az, cz) = (_mm256_mul_ps(lz, iz), _mm256_mul_ps(hz, iz));
-            let t0 = _mm256_max_ps(
-                _mm256_max_ps(_mm256_min_ps(ax, cx), _mm256_min_ps(ay, cy)),
-                _mm256_max_ps(_mm256_min_ps(az, cz), t_min),
-            );
-            let t1 = _mm256_min_ps(
-                _mm256_min_ps(_mm256_max_ps(ax, cx), _mm256_max_ps(ay, cy)),
-                _mm256_min_ps(_mm256_max_ps(az, cz), t_max),
-            );
-            let m = _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(t0, t1)) as u64;
             out |= (m & byte) << (block * 8);
         }
         block += 1;
@@ -415,7 +427,6 @@ unsafe fn misses_avx(s: &[Vec3; 3], span: &[(f32, f32); 3], lanes: &Lanes, maybe
     let (s2x, s2y, s2z) = (sp(s[2].x), sp(s[2].y), sp(s[2].z));
     let sign = sp(-0.0);
     let (lo, hi) = (span.map(|s| sp(s.0)), span.map(|s| sp(s.1)));
-    let (one, two) = (_mm256_set1_epi32(1), _mm256_set1_epi32(2));
     let (t_min, t_max, t_margin) = (sp(SEGMENT_EPS), sp(1.0 - SEGMENT_EPS), sp(T_MARGIN));
     maybe.fill(0);
     let mut j = 0;
@@ -448,10 +459,8 @@ unsafe fn misses_avx(s: &[Vec3; 3], span: &[(f32, f32); 3], lanes: &Lanes, maybe
                 (_mm256_loadu_ps(lanes.sz.as_ptr().add(j)), _mm256_loadu_si256(lanes.kz.as_ptr().add(j).cast()))
             };
             // The span along each lane's own axis.
-            let is1 = _mm256_castsi256_ps(_mm256_cmpeq_epi32(kz, one));
-            let is2 = _mm256_castsi256_ps(_mm256_cmpeq_epi32(kz, two));
-            let pick = |v: [__m256; 3]| _mm256_blendv_ps(_mm256_blendv_ps(v[0], v[1], is1), v[2], is2);
-            let (lo, hi) = (pick(lo), pick(hi));
+            // SAFETY: AVX2 is enabled here.
+            let (lo, hi) = unsafe { (by_axis(kz, lo), by_axis(kz, hi)) };
             let (z1, z2) = (_mm256_mul_ps(lo, sz), _mm256_mul_ps(hi, sz));
             let (zlo, zhi) = (_mm256_min_ps(z1, z2), _mm256_max_ps(z1, z2));
             let abs = |v| _mm256_andnot_ps(sign, v);
@@ -496,13 +505,9 @@ pub(super) unsafe fn exact_avx(a: Vec3, b: Vec3, c: Vec3, shear: &Shear, base: u
         )
     };
     let sp = |v: f32| _mm256_set1_ps(v);
-    let (zero, one) = (_mm256_setzero_si256(), _mm256_set1_epi32(1));
     // Per lane, component `k` of `v`.
-    let pick = |v: Vec3, k: __m256i| {
-        let is0 = _mm256_castsi256_ps(_mm256_cmpeq_epi32(k, zero));
-        let is1 = _mm256_castsi256_ps(_mm256_cmpeq_epi32(k, one));
-        _mm256_blendv_ps(_mm256_blendv_ps(sp(v.z), sp(v.y), is1), sp(v.x), is0)
-    };
+    // SAFETY: AVX2 is enabled here.
+    let pick = |v: Vec3, k: __m256i| unsafe { by_axis(k, [sp(v.x), sp(v.y), sp(v.z)]) };
     let (mul, sub, add) = (|x, y| _mm256_mul_ps(x, y), |x, y| _mm256_sub_ps(x, y), |x, y| _mm256_add_ps(x, y));
     let (akz, bkz, ckz) = (pick(a, kz), pick(b, kz), pick(c, kz));
     let ax = sub(pick(a, kx), mul(sx, akz));

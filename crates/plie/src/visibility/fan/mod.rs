@@ -292,16 +292,7 @@ impl Fan {
         out: &mut [bool],
         ctx: &mut QueryCtx,
     ) {
-        let few = within.iter().zip(&self.open).map(|(w, o)| (w & o).count_ones()).sum::<u32>() <= DIRECT_MAX;
-        if few {
-            let tri = &scene.triangles[t.idx()];
-            for (w, &m) in within.iter().enumerate().take(self.open.len()) {
-                let bits = m & self.open[w];
-                self.exact(tri, w, bits, rays, out, ctx);
-            }
-        } else {
-            self.test_masked(scene, rays, t, Some(within), out, ctx);
-        }
+        self.test_masked(scene, rays, t, Some(within), out, ctx);
     }
 
     /// Rays not yet found occluded.
@@ -316,17 +307,11 @@ impl Fan {
     /// test. The caller has excluded the rays' own triangles (the origin's and the light's).
     #[inline]
     pub fn test(&mut self, scene: &Scene, rays: &LightRays, t: TriId, out: &mut [bool], ctx: &mut QueryCtx) {
-        if self.live as u32 <= DIRECT_MAX {
-            let tri = &scene.triangles[t.idx()];
-            for w in 0..self.open.len() {
-                self.exact(tri, w, self.open[w], rays, out, ctx);
-            }
-        } else {
-            self.test_masked(scene, rays, t, None, out, ctx);
-        }
+        self.test_masked(scene, rays, t, None, out, ctx);
     }
 
-    /// [`Fan::test`], for the open lanes of `within` only when given.
+    /// [`Fan::test`], for the open lanes of `within` only when given: up to [`DIRECT_MAX`] of them
+    /// go straight to the watertight test, more first through the edge test.
     #[inline(always)]
     fn test_masked(
         &mut self,
@@ -338,6 +323,18 @@ impl Fan {
         ctx: &mut QueryCtx,
     ) {
         let tri = &scene.triangles[t.idx()];
+        let mask = |w: usize| within.map_or(u64::MAX, |m| m[w]);
+        let count = match within {
+            None => self.live as u32,
+            Some(_) => (0..self.open.len()).map(|w| (self.open[w] & mask(w)).count_ones()).sum(),
+        };
+        if count <= DIRECT_MAX {
+            for w in 0..self.open.len() {
+                let bits = self.open[w] & mask(w);
+                self.exact(tri, w, bits, rays, out, ctx);
+            }
+            return;
+        }
         let x = self.origin;
         let (a, b, c) = (tri.v[0] - x, tri.v[1] - x, tri.v[2] - x);
         // Edge normals scaled by the inverse of their margins: a lane is a sure miss where one scaled
@@ -364,7 +361,7 @@ impl Fan {
             self.maybe.fill(u64::MAX);
         }
         for w in 0..self.open.len() {
-            let bits = self.maybe[w] & self.open[w] & within.map_or(u64::MAX, |m| m[w]);
+            let bits = self.maybe[w] & self.open[w] & mask(w);
             self.exact(tri, w, bits, rays, out, ctx);
         }
     }
