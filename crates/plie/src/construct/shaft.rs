@@ -53,6 +53,23 @@ impl Shaft {
         let mut pts: Vec<DVec3> = face.iter().map(|p| p.as_dvec3()).collect();
         pts.extend(light.iter().take(MAX_POINTS - 4).map(|p| p.as_dvec3()));
         let bounds = Aabb::from_points(face.iter().chain(light)).expanded(tol);
+        Shaft::hull(pts, bounds, tol)
+    }
+
+    /// The shaft of `conv(near ∪ light)` for any points `near`, grown by `tol`; with more than
+    /// [`MAX_POINTS`] points in all, only the planes of its box.
+    pub fn of_points(near: &[Vec3], light: &[Vec3], tol: f32) -> Shaft {
+        let bounds = Aabb::from_points(near.iter().chain(light)).expanded(tol);
+        let pts = if near.len() + light.len() <= MAX_POINTS {
+            near.iter().chain(light).map(|p| p.as_dvec3()).collect()
+        } else {
+            Vec::new()
+        };
+        Shaft::hull(pts, bounds, tol)
+    }
+
+    /// The supporting planes of the hull of `pts`, moved out by `tol`, and the planes of `bounds`.
+    fn hull(pts: Vec<DVec3>, bounds: Aabb, tol: f32) -> Shaft {
         let tol = tol as f64;
         let scale = pts.iter().fold(0.0f64, |m, p| m.max(p.abs().max_element())).max(1e-30);
         let mut planes: Vec<Plane> = Vec::new();

@@ -17,7 +17,10 @@
 
 use glam::{Vec3, Vec3A};
 
+use obvhs::cwbvh::node::CwBvhNode;
+
 use super::crowd::{Prims, Single};
+use super::cut::Cut;
 use super::Bvh;
 use crate::scene::{Scene, TriId};
 use crate::visibility::fan::{Fan, WalkStack};
@@ -37,15 +40,32 @@ impl Bvh {
         out: &mut [bool],
         ctx: &mut QueryCtx,
     ) {
+        self.fan_occluded_from(None, scene, rays, fan, walk, out, ctx);
+    }
+
+    /// [`Bvh::fan_occluded`], starting from `cut` (see [`Bvh::cut`]) instead of the root when given:
+    /// the cut of a region that holds every segment of the fan.
+    #[allow(clippy::too_many_arguments)]
+    pub(crate) fn fan_occluded_from(
+        &self,
+        cut: Option<&Cut>,
+        scene: &Scene,
+        rays: &LightRays,
+        fan: &mut Fan,
+        walk: &mut WalkStack,
+        out: &mut [bool],
+        ctx: &mut QueryCtx,
+    ) {
         match &self.groups {
-            None => self.fan_walk(&Single, scene, rays, fan, walk, out, ctx),
-            Some(g) => self.fan_walk(g, scene, rays, fan, walk, out, ctx),
+            None => self.fan_walk(cut, &Single, scene, rays, fan, walk, out, ctx),
+            Some(g) => self.fan_walk(cut, g, scene, rays, fan, walk, out, ctx),
         }
     }
 
     #[allow(clippy::too_many_arguments)]
     fn fan_walk<P: Prims>(
         &self,
+        cut: Option<&Cut>,
         prims: &P,
         scene: &Scene,
         rays: &LightRays,
@@ -62,12 +82,47 @@ impl Bvh {
         let to_world = 1.0 / self.scale;
         walk.nodes.clear();
         walk.masks.clear();
-        walk.nodes.push(0);
-        walk.masks.extend_from_slice(fan.open());
         walk.child_masks.resize(8 * w, 0);
         // The order of inner children: nearest first along the first sample's direction.
         let toward = rays.targets[0] - fan.origin();
         let WalkStack { nodes, masks, node_mask, child_masks } = walk;
+        match cut {
+            None => {
+                nodes.push(0);
+                masks.extend_from_slice(fan.open());
+            }
+            Some(cut) => {
+                // The cut's entries as the children of one node per eight: boxes decoded from
+                // their parents as a visit of the parent decodes them.
+                for first in (0..cut.len as usize).step_by(8) {
+                    let n = (cut.len as usize - first).min(8);
+                    let (mut los, mut his) = ([[0f32; 8]; 3], [[0f32; 8]; 3]);
+                    for c in 0..n {
+                        let node = &self.cw.nodes[cut.parent[first + c] as usize];
+                        let e = node.compute_extent();
+                        let base = Vec3A::from(node.p) - apex;
+                        let s = cut.slot[first + c] as usize;
+                        let mins = [node.child_min_x[s], node.child_min_y[s], node.child_min_z[s]];
+                        let maxs = [node.child_max_x[s], node.child_max_y[s], node.child_max_z[s]];
+                        for k in 0..3 {
+                            los[k][c] = (base[k] + e[k] * f32::from(mins[k])) * to_world;
+                            his[k][c] = (base[k] + e[k] * f32::from(maxs[k])) * to_world;
+                        }
+                    }
+                    let culled = fan.pyramid.culls_rel8(&los, &his);
+                    let filled = ((1u16 << n) - 1) as u8;
+                    node_mask.clear();
+                    node_mask.extend_from_slice(fan.open());
+                    let hit = fan.meets8(&los, &his, filled & !culled, node_mask, child_masks, ctx);
+                    let slot =
+                        |c: usize| (&self.cw.nodes[cut.parent[first + c] as usize], cut.slot[first + c] as usize);
+                    let at = (hit, &los, &his, slot);
+                    if self.take_children(prims, scene, rays, fan, out, ctx, at, toward, nodes, masks, child_masks) {
+                        return;
+                    }
+                }
+            }
+        }
         while let Some(ni) = nodes.pop() {
             let at = masks.len() - w;
             // Word by word: masks are one or two words, too short for a copy call.
@@ -97,45 +152,85 @@ impl Bvh {
             let culled = fan.pyramid.culls_rel8(&los, &his);
             let filled = node.child_meta.iter().enumerate().fold(0u8, |b, (c, &m)| b | u8::from(m != 0) << c);
             let hit = fan.meets8(&los, &his, filled & !culled, node_mask, child_masks, ctx);
-            let mut pending = [(0f32, 0u32, 0usize); 8];
-            let mut count = 0;
-            for child in (0..8).filter(|c| hit >> c & 1 != 0) {
-                let mask = &child_masks[child * w..(child + 1) * w];
-                if node.is_leaf(child) {
-                    let (start, len) = node.child_primitives(child);
-                    for p in start..start + len {
-                        for &t in prims.of(&self.cw.primitive_indices[p as usize]) {
-                            let t = TriId(t);
-                            if t == rays.origin_tri || scene.tri_light[t.idx()] == Some(rays.light) {
-                                continue;
-                            }
-                            fan.test_within(scene, rays, t, mask, out, ctx);
-                        }
-                    }
-                    if fan.live() == 0 {
-                        return;
-                    }
-                } else {
-                    let centre = Vec3::new(
-                        los[0][child] + his[0][child],
-                        los[1][child] + his[1][child],
-                        los[2][child] + his[2][child],
-                    );
-                    pending[count] = (centre.dot(toward), node.child_node_index(child), child);
-                    count += 1;
-                }
+            let slot = |c: usize| (node, c);
+            let done = self.take_children(
+                prims,
+                scene,
+                rays,
+                fan,
+                out,
+                ctx,
+                (hit, &los, &his, slot),
+                toward,
+                nodes,
+                masks,
+                child_masks,
+            );
+            if done {
+                return;
             }
-            if count > 0 {
-                // Nearest last, so it is visited first.
-                let pending = &mut pending[..count];
-                pending.sort_unstable_by(|a, b| b.0.total_cmp(&a.0));
-                for &(_, n, slot) in pending.iter() {
-                    nodes.push(n);
-                    for &m in &child_masks[slot * w..(slot + 1) * w] {
-                        masks.push(m);
+        }
+    }
+    /// The children `hit` of a visit (child `c` being slot `slot(c).1` of node `slot(c).0`, its box
+    /// `los`/`his` relative to the apex, its rays in `child_masks`): a leaf's triangles are tested
+    /// against its rays, inner nodes pushed nearest first. True once every ray is closed.
+    #[allow(clippy::too_many_arguments)]
+    #[inline(always)]
+    fn take_children<'n, P: Prims>(
+        &'n self,
+        prims: &P,
+        scene: &Scene,
+        rays: &LightRays,
+        fan: &mut Fan,
+        out: &mut [bool],
+        ctx: &mut QueryCtx,
+        (hit, los, his, slot): (u8, &[[f32; 8]; 3], &[[f32; 8]; 3], impl Fn(usize) -> (&'n CwBvhNode, usize)),
+        toward: Vec3,
+        nodes: &mut Vec<u32>,
+        masks: &mut Vec<u64>,
+        child_masks: &[u64],
+    ) -> bool {
+        let w = fan.words();
+        let mut pending = [(0f32, 0u32, 0usize); 8];
+        let mut count = 0;
+        for child in (0..8).filter(|c| hit >> c & 1 != 0) {
+            let mask = &child_masks[child * w..(child + 1) * w];
+            let (node, s) = slot(child);
+            if node.is_leaf(s) {
+                let (start, len) = node.child_primitives(s);
+                for p in start..start + len {
+                    for &t in prims.of(&self.cw.primitive_indices[p as usize]) {
+                        let t = TriId(t);
+                        if t == rays.origin_tri || scene.tri_light[t.idx()] == Some(rays.light) {
+                            continue;
+                        }
+                        fan.test_within(scene, rays, t, mask, out, ctx);
                     }
+                }
+                if fan.live() == 0 {
+                    return true;
+                }
+            } else {
+                let centre = Vec3::new(
+                    los[0][child] + his[0][child],
+                    los[1][child] + his[1][child],
+                    los[2][child] + his[2][child],
+                );
+                pending[count] = (centre.dot(toward), node.child_node_index(s), child);
+                count += 1;
+            }
+        }
+        if count > 0 {
+            // Nearest last, so it is visited first.
+            let pending = &mut pending[..count];
+            pending.sort_unstable_by(|a, b| b.0.total_cmp(&a.0));
+            for &(_, n, slot) in pending.iter() {
+                nodes.push(n);
+                for &m in &child_masks[slot * w..(slot + 1) * w] {
+                    masks.push(m);
                 }
             }
         }
+        false
     }
 }

@@ -37,7 +37,10 @@ pub use crowd::CROWD_LIMIT;
 use crowd::{group_crowded_centres, Groups, Prims, Single};
 
 mod crowd;
+mod cut;
 mod fan_walk;
+
+pub use cut::{Cut, CUT_MAX};
 
 /// Size of the scene in the BVH's normalised space.
 const NORMALISED_SIZE: f32 = 1000.0;

@@ -78,22 +78,28 @@ impl LieVisibility<'_> {
                 ctx.stats.answers.count_n(Answer::Umbra, out.len());
             }
             // A leaf with many triangles of its own: the BVH culls them better than the fan does.
-            Whole::Lit | Whole::Lists if self.own[leaf.idx()].1 as usize > OWN_MAX => self.by_scene(rays, sc, out, ctx),
+            Whole::Lit | Whole::Lists if self.own[leaf.idx()].1 as usize > OWN_MAX => {
+                self.by_scene(leaf, rays, sc, out, ctx)
+            }
             Whole::Lit => self.own_only(leaf, rays, sc, out, ctx),
             Whole::Lists => self.lists_only(leaf, rays, sc, out, ctx),
-            Whole::Mixed => self.by_scene(rays, sc, out, ctx),
+            Whole::Mixed => self.by_scene(leaf, rays, sc, out, ctx),
         }
         ctx.light = scratch;
     }
 
-    /// [`Whole::Mixed`]: every sample down the scene BVH at once, for the whole segment.
-    fn by_scene(&self, rays: &LightRays, sc: &mut LightScratch, out: &mut [bool], ctx: &mut QueryCtx) {
+    /// [`Whole::Mixed`]: every sample down the scene BVH at once, for the whole segment, from the
+    /// cut of the leaf and the light ([`crate::visibility::bvh::Cut`]).
+    fn by_scene(&self, leaf: LeafId, rays: &LightRays, sc: &mut LightScratch, out: &mut [bool], ctx: &mut QueryCtx) {
         out.fill(false);
         ctx.stats.lights.scene += 1;
         sc.fan.set(rays);
         sc.fan.pyramid.set_in(self.scene, rays.origin, rays.light);
         let before = ctx.stats.triangle_tests;
-        self.bvh.fan_occluded(self.scene, rays, &mut sc.fan, &mut sc.walk, out, ctx);
+        // The cut holds every triangle a segment from the leaf to the light can meet.
+        debug_assert!(self.octree.leaf_bounds(leaf).expanded(self.scene.scale() * 1e-5).contains(rays.origin));
+        let cut = &self.cuts[leaf.idx() * self.scene.lights.len() + rays.light.idx()];
+        self.bvh.fan_occluded_from(Some(cut), self.scene, rays, &mut sc.fan, &mut sc.walk, out, ctx);
         ctx.stats.blocker_tests += ctx.stats.triangle_tests - before;
         ctx.stats.answers.count_n(Answer::SceneBvh, out.len());
     }

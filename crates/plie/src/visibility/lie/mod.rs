@@ -25,10 +25,13 @@
 mod light;
 mod whole;
 
-use super::bvh::{segment_occluded, Bvh};
+use super::bvh::{segment_occluded, Bvh, Cut};
 use super::leaf_voxels::LeafVoxels;
 use super::list_boxes::{Chunked, ListBoxes, ListVisitor};
 use super::{blocks, Answer, LightRays, Mode, OctreeVisibility, QueryCtx, ShadowRay, Visibility};
+use glam::{BVec3, Vec3};
+
+use crate::construct::shaft::Shaft;
 use crate::geometry::{Aabb, Segment};
 use crate::lie::frame::{in_triangles, FaceFrame};
 use crate::lie::grid;
@@ -69,6 +72,9 @@ pub struct LieVisibility<'a> {
     /// without a list (umbra or scene), in the cells `[0, i) x [0, j)`. A footprint's cells are then
     /// counted in four lookups.
     sat: Vec<[u32; 3]>,
+    /// Per (leaf, light), `leaf * lights + light`: where the scene BVH's walk starts for a light
+    /// answered by the scene ([`Bvh::cut`] of the box around the leaf and the light).
+    cuts: Vec<Cut>,
 }
 
 impl<'a> LieVisibility<'a> {
@@ -96,6 +102,7 @@ impl<'a> LieVisibility<'a> {
         }
         let own_boxes = ListBoxes::new(own.iter().copied(), &own_tris, &tri_boxes);
         let (sat_start, sat) = if mode == Mode::Grid { whole::grid_tables(plie) } else { (Vec::new(), Vec::new()) };
+        let cuts = leaf_cuts(scene, octree, bvh, pad);
         LieVisibility {
             scene,
             octree,
@@ -111,6 +118,7 @@ impl<'a> LieVisibility<'a> {
             own_boxes,
             sat_start,
             sat,
+            cuts,
         }
     }
 
@@ -157,8 +165,29 @@ pub fn exit_face(octree: &Octree, leaf: LeafId, ray: &ShadowRay) -> Option<(Dir,
 }
 
 /// [`exit_face`] for the box `b` and the segment `o + t d`, `t < t_max`.
+/// The cut of the scene BVH for every (leaf, light), at `leaf * lights + light`: the children
+/// whose boxes meet the hull of the leaf's box and the light polygon (grown by `pad`), which holds
+/// every segment from a point of the leaf to a point of the light.
+fn leaf_cuts(scene: &Scene, octree: &Octree, bvh: &Bvh, pad: f32) -> Vec<Cut> {
+    use rayon::prelude::*;
+    let leaves: Vec<LeafId> = octree.leaves().collect();
+    leaves
+        .par_iter()
+        .flat_map_iter(|&leaf| {
+            let b = octree.leaf_bounds(leaf);
+            let corners: [Vec3; 8] =
+                std::array::from_fn(|k| Vec3::select(BVec3::new(k & 1 != 0, k & 2 != 0, k & 4 != 0), b.max, b.min));
+            scene.lights.iter().map(move |l| {
+                let region = Aabb::from_points(l.vertices.iter().chain(&corners)).expanded(pad);
+                let shaft = Shaft::of_points(&corners, &l.vertices, pad);
+                bvh.cut(&region, |b| shaft.may_overlap_box(b))
+            })
+        })
+        .collect()
+}
+
 #[inline]
-fn exit_face_of(b: &Aabb, o: glam::Vec3, d: glam::Vec3, t_max: f32) -> Option<(Dir, f32)> {
+fn exit_face_of(b: &Aabb, o: Vec3, d: Vec3, t_max: f32) -> Option<(Dir, f32)> {
     let mut best = (t_max, None);
     for k in 0..3 {
         let (t, positive) = if d[k] > 0.0 {
