@@ -1,27 +1,61 @@
-//! Where a fan's walk down the scene BVH starts (issue 21; issue 15's "bounded cut"): for a region
-//! of space (the box around an octree leaf and a light), at most [`CUT_MAX`] children of BVH nodes
-//! whose boxes hold every triangle box that meets the region. A fan from a point of the leaf to the
-//! light lies inside the region, so testing the cut's boxes as one node ([`super::Bvh::fan_occluded`])
-//! finds every triangle a walk from the root would, without visiting the nodes above the cut.
+//! Where a fan's walk down the scene BVH starts (issue 21; issue 15's "bounded cut"): for an octree
+//! leaf and a light, at most [`CUT_MAX`] children of BVH nodes whose boxes hold every triangle box
+//! that meets the hull of the leaf's box and the light polygon. A fan from a point of the leaf to the
+//! light lies inside that hull, so testing the cut's boxes as the children of one node
+//! ([`super::Bvh::fan_occluded_from`]) reaches every triangle a walk from the root would, without
+//! visiting the nodes above the cut.
 //!
-//! The cut is chosen greedily: the root's children that meet the region, then the largest inner child
-//! replaced by its own children that meet it, as long as at most [`CUT_MAX`] remain.
+//! The cut is chosen greedily: the root's children that meet the region, then the inner child with
+//! the largest box replaced by its own children that meet it, as long as at most [`CUT_MAX`] remain.
+//! It keeps its entries' boxes (decoded from their parents as a walk decodes them) and what they
+//! lead to, so a walk reads one cut and no parent node.
 
 use glam::Vec3;
+use obvhs::cwbvh::node::CwBvhNode;
 
 use super::{Bvh, PAD};
 use crate::geometry::Aabb;
 
-/// Most entries of a cut: one node's worth of box lanes (measured: 16 helped conference-lit and cost on the others).
+/// Most entries of a cut: one node's worth of box lanes. Measured (callgrind at 64 rays): 16 cost
+/// more than 8 on huis-c, cornell-bunny and cornell-dragon-100k, and less on conference-lit.
 pub const CUT_MAX: usize = 8;
 
-/// A cut: up to [`CUT_MAX`] children, each named by its parent node and its slot there.
+/// What a cut's entry (a child of a BVH node) leads to.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Child {
+    /// No entry.
+    #[default]
+    None,
+    /// An inner node.
+    Node(u32),
+    /// A leaf: `(start, len)` in the primitive indices.
+    Leaf(u32, u32),
+}
+
+impl Child {
+    /// Child `c` of `node` (which has one there).
+    #[inline]
+    pub(super) fn of(node: &CwBvhNode, c: usize) -> Child {
+        if node.is_leaf(c) {
+            let (start, len) = node.child_primitives(c);
+            Child::Leaf(start, len)
+        } else {
+            Child::Node(node.child_node_index(c))
+        }
+    }
+}
+
+/// A cut: up to [`CUT_MAX`] children of BVH nodes, with their boxes (in the BVH's normalised units,
+/// as the walk decodes them from their parents) in lanes, so that a walk reads the cut without
+/// reading the parents.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Cut {
-    /// Parent node of each entry.
-    pub parent: [u32; CUT_MAX],
-    /// Child slot of each entry in its parent.
-    pub slot: [u8; CUT_MAX],
+    /// Per axis, the entries' lower bounds.
+    pub lo: [[f32; CUT_MAX]; 3],
+    /// Per axis, the entries' upper bounds.
+    pub hi: [[f32; CUT_MAX]; 3],
+    /// What each entry leads to.
+    pub child: [Child; CUT_MAX],
     /// Entries.
     pub len: u8,
 }
@@ -80,8 +114,11 @@ impl Bvh {
         // The root has at most eight children, and every step keeps at most `CUT_MAX`.
         debug_assert!(entries.len() <= CUT_MAX);
         for (k, &(p, c)) in entries.iter().enumerate() {
-            cut.parent[k] = p;
-            cut.slot[k] = c;
+            let (lo, hi) = self.child_box(p, c as usize);
+            for a in 0..3 {
+                (cut.lo[a][k], cut.hi[a][k]) = (lo[a], hi[a]);
+            }
+            cut.child[k] = Child::of(&self.cw.nodes[p as usize], c as usize);
         }
         cut.len = entries.len() as u8;
         cut
@@ -89,7 +126,7 @@ impl Bvh {
 
     /// The box of child `c` of node `n`, in normalised units, as the walks decode it.
     #[inline]
-    pub(super) fn child_box(&self, n: u32, c: usize) -> (Vec3, Vec3) {
+    fn child_box(&self, n: u32, c: usize) -> (Vec3, Vec3) {
         let node = &self.cw.nodes[n as usize];
         let e = node.compute_extent();
         let lo =
@@ -136,19 +173,19 @@ mod tests {
             assert!(cut.len as usize <= super::CUT_MAX);
             // The triangles under the cut.
             let mut under = vec![false; scene.triangles.len()];
-            let mut todo: Vec<(u32, usize)> =
-                (0..cut.len as usize).map(|k| (cut.parent[k], cut.slot[k] as usize)).collect();
-            while let Some((n, c)) = todo.pop() {
-                let node = &bvh.cw.nodes[n as usize];
-                if node.is_leaf(c) {
-                    let (start, len) = node.child_primitives(c);
-                    for p in start..start + len {
-                        under[bvh.cw.primitive_indices[p as usize] as usize] = true;
+            let mut todo: Vec<super::Child> = cut.child[..cut.len as usize].to_vec();
+            while let Some(c) = todo.pop() {
+                match c {
+                    super::Child::None => unreachable!("an entry leads somewhere"),
+                    super::Child::Leaf(start, len) => {
+                        for p in start..start + len {
+                            under[bvh.cw.primitive_indices[p as usize] as usize] = true;
+                        }
                     }
-                } else {
-                    let child = node.child_node_index(c);
-                    let inner = &bvh.cw.nodes[child as usize];
-                    todo.extend((0..8).filter(|&k| inner.child_meta[k] != 0).map(|k| (child, k)));
+                    super::Child::Node(n) => {
+                        let node = &bvh.cw.nodes[n as usize];
+                        todo.extend((0..8).filter(|&k| node.child_meta[k] != 0).map(|k| super::Child::of(node, k)));
+                    }
                 }
             }
             for (t, tri) in scene.triangles.iter().enumerate() {
@@ -157,7 +194,10 @@ mod tests {
                     assert!(under[t], "triangle {t} meets the region but is not under its cut");
                 }
             }
-            deeper += usize::from(cut.parent[..cut.len as usize].iter().any(|&p| p != 0));
+            let root = &bvh.cw.nodes[0];
+            let top: Vec<super::Child> =
+                (0..8).filter(|&k| root.child_meta[k] != 0).map(|k| super::Child::of(root, k)).collect();
+            deeper += usize::from(!cut.child[..cut.len as usize].iter().all(|c| top.contains(c)));
         }
         // Most cuts reach below the root's children (else they would save nothing).
         eprintln!("{deeper} of 300 cuts below the root's children");

@@ -17,10 +17,8 @@
 
 use glam::{Vec3, Vec3A};
 
-use obvhs::cwbvh::node::CwBvhNode;
-
 use super::crowd::{Prims, Single};
-use super::cut::Cut;
+use super::cut::{Child, Cut};
 use super::Bvh;
 use crate::scene::{Scene, TriId};
 use crate::visibility::fan::{Fan, WalkStack};
@@ -92,21 +90,15 @@ impl Bvh {
                 masks.extend_from_slice(fan.open());
             }
             Some(cut) => {
-                // The cut's entries as the children of one node per eight: boxes decoded from
-                // their parents as a visit of the parent decodes them.
+                // The cut's entries as the children of one node per eight, their boxes made
+                // relative to the apex.
                 for first in (0..cut.len as usize).step_by(8) {
                     let n = (cut.len as usize - first).min(8);
                     let (mut los, mut his) = ([[0f32; 8]; 3], [[0f32; 8]; 3]);
-                    for c in 0..n {
-                        let node = &self.cw.nodes[cut.parent[first + c] as usize];
-                        let e = node.compute_extent();
-                        let base = Vec3A::from(node.p) - apex;
-                        let s = cut.slot[first + c] as usize;
-                        let mins = [node.child_min_x[s], node.child_min_y[s], node.child_min_z[s]];
-                        let maxs = [node.child_max_x[s], node.child_max_y[s], node.child_max_z[s]];
-                        for k in 0..3 {
-                            los[k][c] = (base[k] + e[k] * f32::from(mins[k])) * to_world;
-                            his[k][c] = (base[k] + e[k] * f32::from(maxs[k])) * to_world;
+                    for k in 0..3 {
+                        for c in 0..n {
+                            los[k][c] = (cut.lo[k][first + c] - apex[k]) * to_world;
+                            his[k][c] = (cut.hi[k][first + c] - apex[k]) * to_world;
                         }
                     }
                     let culled = fan.pyramid.culls_rel8(&los, &his);
@@ -114,9 +106,7 @@ impl Bvh {
                     node_mask.clear();
                     node_mask.extend_from_slice(fan.open());
                     let hit = fan.meets8(&los, &his, filled & !culled, node_mask, child_masks, ctx);
-                    let slot =
-                        |c: usize| (&self.cw.nodes[cut.parent[first + c] as usize], cut.slot[first + c] as usize);
-                    let at = (hit, &los, &his, slot);
+                    let at = (hit, &los, &his, |c: usize| cut.child[first + c]);
                     if self.take_children(prims, scene, rays, fan, out, ctx, at, toward, nodes, masks, child_masks) {
                         return;
                     }
@@ -152,7 +142,7 @@ impl Bvh {
             let culled = fan.pyramid.culls_rel8(&los, &his);
             let filled = node.child_meta.iter().enumerate().fold(0u8, |b, (c, &m)| b | u8::from(m != 0) << c);
             let hit = fan.meets8(&los, &his, filled & !culled, node_mask, child_masks, ctx);
-            let slot = |c: usize| (node, c);
+            let slot = |c: usize| Child::of(node, c);
             let done = self.take_children(
                 prims,
                 scene,
@@ -176,15 +166,15 @@ impl Bvh {
     /// against its rays, inner nodes pushed nearest first. True once every ray is closed.
     #[allow(clippy::too_many_arguments)]
     #[inline(always)]
-    fn take_children<'n, P: Prims>(
-        &'n self,
+    fn take_children<P: Prims>(
+        &self,
         prims: &P,
         scene: &Scene,
         rays: &LightRays,
         fan: &mut Fan,
         out: &mut [bool],
         ctx: &mut QueryCtx,
-        (hit, los, his, slot): (u8, &[[f32; 8]; 3], &[[f32; 8]; 3], impl Fn(usize) -> (&'n CwBvhNode, usize)),
+        (hit, los, his, child_of): (u8, &[[f32; 8]; 3], &[[f32; 8]; 3], impl Fn(usize) -> Child),
         toward: Vec3,
         nodes: &mut Vec<u32>,
         masks: &mut Vec<u64>,
@@ -195,29 +185,31 @@ impl Bvh {
         let mut count = 0;
         for child in (0..8).filter(|c| hit >> c & 1 != 0) {
             let mask = &child_masks[child * w..(child + 1) * w];
-            let (node, s) = slot(child);
-            if node.is_leaf(s) {
-                let (start, len) = node.child_primitives(s);
-                for p in start..start + len {
-                    for &t in prims.of(&self.cw.primitive_indices[p as usize]) {
-                        let t = TriId(t);
-                        if t == rays.origin_tri || scene.tri_light[t.idx()] == Some(rays.light) {
-                            continue;
+            match child_of(child) {
+                Child::None => {}
+                Child::Leaf(start, len) => {
+                    for p in start..start + len {
+                        for &t in prims.of(&self.cw.primitive_indices[p as usize]) {
+                            let t = TriId(t);
+                            if t == rays.origin_tri || scene.tri_light[t.idx()] == Some(rays.light) {
+                                continue;
+                            }
+                            fan.test_within(scene, rays, t, mask, out, ctx);
                         }
-                        fan.test_within(scene, rays, t, mask, out, ctx);
+                    }
+                    if fan.live() == 0 {
+                        return true;
                     }
                 }
-                if fan.live() == 0 {
-                    return true;
+                Child::Node(n) => {
+                    let centre = Vec3::new(
+                        los[0][child] + his[0][child],
+                        los[1][child] + his[1][child],
+                        los[2][child] + his[2][child],
+                    );
+                    pending[count] = (centre.dot(toward), n, child);
+                    count += 1;
                 }
-            } else {
-                let centre = Vec3::new(
-                    los[0][child] + his[0][child],
-                    los[1][child] + his[1][child],
-                    los[2][child] + his[2][child],
-                );
-                pending[count] = (centre.dot(toward), node.child_node_index(s), child);
-                count += 1;
             }
         }
         if count > 0 {

@@ -73,7 +73,8 @@ pub struct LieVisibility<'a> {
     /// counted in four lookups.
     sat: Vec<[u32; 3]>,
     /// Per (leaf, light), `leaf * lights + light`: where the scene BVH's walk starts for a light
-    /// answered by the scene ([`Bvh::cut`] of the box around the leaf and the light).
+    /// answered by the scene ([`Bvh::cut`] of the hull of the leaf and the light). Empty when they
+    /// would take too much memory: the walks then start at the root.
     cuts: Vec<Cut>,
 }
 
@@ -164,12 +165,17 @@ pub fn exit_face(octree: &Octree, leaf: LeafId, ray: &ShadowRay) -> Option<(Dir,
     exit_face_of(&octree.leaf_bounds(leaf), ray.test.origin, ray.test.dir, ray.test.t_max)
 }
 
-/// [`exit_face`] for the box `b` and the segment `o + t d`, `t < t_max`.
 /// The cut of the scene BVH for every (leaf, light), at `leaf * lights + light`: the children
 /// whose boxes meet the hull of the leaf's box and the light polygon (grown by `pad`), which holds
-/// every segment from a point of the leaf to a point of the light.
+/// every segment from a point of the leaf to a point of the light. None (every walk starts at the
+/// root) when they would take more than [`CUTS_MAX_BYTES`].
 fn leaf_cuts(scene: &Scene, octree: &Octree, bvh: &Bvh, pad: f32) -> Vec<Cut> {
     use rayon::prelude::*;
+    let bytes =
+        (octree.leaf_count() as u64 * scene.lights.len() as u64).saturating_mul(std::mem::size_of::<Cut>() as u64);
+    if bytes > CUTS_MAX_BYTES {
+        return Vec::new();
+    }
     let leaves: Vec<LeafId> = octree.leaves().collect();
     leaves
         .par_iter()
@@ -186,6 +192,10 @@ fn leaf_cuts(scene: &Scene, octree: &Octree, bvh: &Bvh, pad: f32) -> Vec<Cut> {
         .collect()
 }
 
+/// Most bytes the cuts of a P-LIE's (leaf, light) pairs may take (about 290 a pair): 256 MiB.
+const CUTS_MAX_BYTES: u64 = 256 << 20;
+
+/// [`exit_face`] for the box `b` and the segment `o + t d`, `t < t_max`.
 #[inline]
 fn exit_face_of(b: &Aabb, o: Vec3, d: Vec3, t_max: f32) -> Option<(Dir, f32)> {
     let mut best = (t_max, None);
