@@ -18,11 +18,11 @@ use crate::geometry::Aabb;
 
 /// Most entries of a cut: one node's worth of box lanes. Measured (callgrind at 64 rays): 16 cost
 /// more than 8 on huis-c, cornell-bunny and cornell-dragon-100k, and less on conference-lit.
-pub const CUT_MAX: usize = 8;
+pub(crate) const CUT_MAX: usize = 8;
 
 /// What a cut's entry (a child of a BVH node) leads to.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum Child {
+pub(crate) enum Child {
     /// No entry.
     #[default]
     None,
@@ -49,7 +49,7 @@ impl Child {
 /// as the walk decodes them from their parents) in lanes, so that a walk reads the cut without
 /// reading the parents.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct Cut {
+pub(crate) struct Cut {
     /// Per axis, the entries' lower bounds.
     pub lo: [[f32; CUT_MAX]; 3],
     /// Per axis, the entries' upper bounds.
@@ -64,7 +64,7 @@ impl Bvh {
     /// The cut of the region `region` (world units; see the module documentation), keeping only the
     /// children whose boxes (in world units, grown by twice the padding) `keep` accepts: `keep` must
     /// accept every box that meets a segment of the fans the cut serves. An empty BVH has an empty cut.
-    pub fn cut(&self, region: &Aabb, keep: impl Fn(&Aabb) -> bool) -> Cut {
+    pub(crate) fn cut(&self, region: &Aabb, keep: impl Fn(&Aabb) -> bool) -> Cut {
         let mut cut = Cut::default();
         if self.cw.nodes.is_empty() {
             return cut;
@@ -202,5 +202,62 @@ mod tests {
         // Most cuts reach below the root's children (else they would save nothing).
         eprintln!("{deeper} of 300 cuts below the root's children");
         assert!(deeper > 150, "{deeper} of 300 cuts below the root's children");
+    }
+
+    /// Fans of 32 rays from random points of random boxes to a light, walked from the box's cut
+    /// and from the root: the same answers, and brute force's.
+    #[test]
+    fn a_walk_from_the_cut_answers_as_one_from_the_root() {
+        use crate::scene::{LightId, TriId};
+        use crate::visibility::fan::{Fan, WalkStack};
+        use crate::visibility::{Brute, LightRays, QueryCtx, Visibility};
+
+        let scene = crate::scene::builtin::load("huis-c").unwrap();
+        let bvh = Bvh::build(&scene);
+        let brute = Brute::new(&scene);
+        let (lo, size) = (scene.bounds.min, scene.bounds.max - scene.bounds.min);
+        let mut state = 5u64;
+        let mut rnd = || {
+            state = mix64(state);
+            (state >> 40) as f32 / (1u64 << 24) as f32
+        };
+        let mut ctx = QueryCtx::new(scene.triangles.len());
+        let (mut fan, mut walk) = (Fan::default(), WalkStack::default());
+        let (mut occluded, mut total) = (0, 0);
+        for _ in 0..200 {
+            let p = lo + size * Vec3::new(rnd(), rnd(), rnd()) * 0.9;
+            let b = Aabb { min: p, max: p + size * (0.01 + 0.1 * rnd()) };
+            let li = (rnd() * scene.lights.len() as f32) as usize % scene.lights.len();
+            let light = &scene.lights[li];
+            let corners: Vec<Vec3> =
+                (0..8).map(|k| Vec3::select(glam::BVec3::new(k & 1 != 0, k & 2 != 0, k & 4 != 0), b.max, b.min)).collect();
+            let pad = scene.scale() * 1e-5;
+            let region = Aabb::from_points(light.vertices.iter().chain(&corners)).expanded(pad);
+            let shaft = Shaft::of_points(&corners, &light.vertices, pad);
+            let cut = bvh.cut(&region, |b| shaft.may_overlap_box(b));
+            let x = b.min + (b.max - b.min) * Vec3::new(rnd(), rnd(), rnd());
+            let v = &light.vertices;
+            let targets: Vec<Vec3> = (0..32)
+                .map(|_| {
+                    let (s, t) = (rnd(), rnd());
+                    v[0] + (v[1] - v[0]) * s + (v[v.len() - 1] - v[0]) * t * (1.0 - s)
+                })
+                .collect();
+            let rays = LightRays { origin: x, origin_tri: TriId(u32::MAX), leaf: None, light: LightId(li as u32), targets: &targets };
+            let mut answers = [[false; 32]; 2];
+            for (k, from) in [Some(&cut), None].into_iter().enumerate() {
+                fan.set(&rays);
+                fan.pyramid.set_in(&scene, x, rays.light);
+                bvh.fan_occluded_from(from, &scene, &rays, &mut fan, &mut walk, &mut answers[k], &mut ctx);
+            }
+            assert_eq!(answers[0], answers[1], "cut against root");
+            for (k, &a) in answers[0].iter().enumerate() {
+                assert_eq!(a, brute.occluded(&rays.ray(k), &mut ctx), "ray {k}");
+                occluded += usize::from(a);
+                total += 1;
+            }
+        }
+        // Both answers occur (319 of 6,400 rays are occluded).
+        assert!(occluded > total / 40 && occluded < total * 9 / 10, "{occluded} of {total} occluded");
     }
 }

@@ -8,7 +8,9 @@
 //! still in the node's mask, eight rays at a time, or one ray against all eight boxes where the
 //! node's rays are few and spread out ([`Fan::meets8`]); a leaf's triangles are tested
 //! against the rays that met its box ([`Fan::test_within`]). Inner children are visited nearest
-//! first (along the first sample's direction), so that blockers close the rays early.
+//! first (along the first sample's direction), so that blockers close the rays early. The P-LIE
+//! modes start below the root, from the cut of the point's leaf and the light ([`super::cut`]),
+//! whose entries are tested as the children of one node.
 //!
 //! The boxes are the BVH's own (each triangle's box padded by `PAD` in its normalised space), taken
 //! back to world units relative to the fan's apex; the rounding of that is far below the padding, so

@@ -40,7 +40,7 @@ mod crowd;
 mod cut;
 mod fan_walk;
 
-pub use cut::{Child, Cut, CUT_MAX};
+pub(crate) use cut::Cut;
 
 /// Size of the scene in the BVH's normalised space.
 const NORMALISED_SIZE: f32 = 1000.0;

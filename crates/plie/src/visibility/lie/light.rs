@@ -4,7 +4,8 @@
 //! cells or in umbra, or gather the short lists of the cells under them, tested as a fan
 //! ([`super::super::fan`]) with the leaf's own triangles. Any other light (footprints over penumbra
 //! and umbra alike, long lists, records that store no list, a leaf crowded with triangles of its
-//! own) is answered by the scene BVH, all samples at once (`Bvh::fan_occluded`): measured, that beat
+//! own) is answered by the scene BVH, all samples at once, starting from the cut of the leaf and the
+//! light (`Bvh::fan_occluded_from`, [`crate::visibility::bvh::Cut`]): measured, that beat
 //! finding each sample's exit face, record and cell and testing its own list on every scene tried
 //! (docs/results.md, session 8).
 
