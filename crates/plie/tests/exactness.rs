@@ -101,6 +101,38 @@ fn every_mode_matches_brute_force_on_builtin_scenes() {
     }
 }
 
+/// A floor, 300 small blockers and a 24-sided light: the shafts' planes are chosen from the first
+/// 16 of a face's corners and the light's vertices, and must still hold the other vertices.
+#[test]
+fn every_mode_matches_brute_force_with_a_many_sided_light() {
+    use glam::Vec3;
+    let mut b = plie::SceneBuilder::new("many-sided light");
+    let m = b.diffuse("white", Vec3::splat(0.5));
+    b.quad(
+        Vec3::new(-3.0, 0.0, -3.0),
+        Vec3::new(-3.0, 0.0, 3.0),
+        Vec3::new(3.0, 0.0, 3.0),
+        Vec3::new(3.0, 0.0, -3.0),
+        m,
+    );
+    let mut rng = TestRng(77);
+    for _ in 0..300 {
+        let c = rng.point_in(Vec3::new(-2.5, 0.3, -2.5), Vec3::new(2.5, 2.7, 2.5));
+        let e1 = rng.point_in(Vec3::new(-0.2, 0.0, -0.2), Vec3::new(0.2, 0.0, 0.2));
+        let e2 = rng.point_in(Vec3::new(-0.05, -0.2, 0.1), Vec3::new(0.05, 0.2, 0.1));
+        b.triangle(c, c + e1, c + e2, m);
+    }
+    let light: Vec<Vec3> = (0..24)
+        .map(|k| {
+            let a = k as f32 / 24.0 * std::f32::consts::TAU;
+            Vec3::new(1.5 * a.cos(), 3.0, 1.5 * a.sin())
+        })
+        .collect();
+    b.light("disc", &light, Vec3::ONE);
+    let scene = b.build().unwrap();
+    check_scene(&scene, SEGMENTS_FAST, 91);
+}
+
 #[test]
 #[ignore = "exhaustive tier (100k rays per scene): cargo test --workspace -- --ignored"]
 fn every_mode_matches_brute_force_on_builtin_scenes_many_rays() {

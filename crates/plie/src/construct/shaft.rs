@@ -12,8 +12,9 @@ use glam::{DVec3, Vec3};
 
 use crate::geometry::Aabb;
 
-/// Most points a shaft is built from (4 face corners + light vertices); longer light polygons are
-/// bounded by their box planes only beyond this.
+/// Most points a shaft's planes are chosen from (4 face corners + light vertices): each passes through
+/// three of the first `MAX_POINTS` points, and is kept only if every point, the rest included, lies
+/// on its inner side. A longer light polygon can only get fewer planes (a larger shaft).
 pub const MAX_POINTS: usize = 16;
 
 /// Vertices of the stack buffers [`Shaft::clips_triangle`] clips in when the shaft has at most
@@ -50,30 +51,25 @@ pub struct Shaft {
 impl Shaft {
     /// The shaft of `conv(face ∪ light)`, grown by `tol`.
     pub fn new(face: &[Vec3; 4], light: &[Vec3], tol: f32) -> Shaft {
-        let mut pts: Vec<DVec3> = face.iter().map(|p| p.as_dvec3()).collect();
-        pts.extend(light.iter().take(MAX_POINTS - 4).map(|p| p.as_dvec3()));
-        let bounds = Aabb::from_points(face.iter().chain(light)).expanded(tol);
-        Shaft::hull(pts, bounds, tol)
+        Shaft::of_points(face, light, tol)
     }
 
-    /// The shaft of `conv(near ∪ light)` for any points `near`, grown by `tol`; with more than
-    /// [`MAX_POINTS`] points in all, only the planes of its box.
+    /// The shaft of `conv(near ∪ light)` for any points `near`, grown by `tol`. Its planes are those
+    /// through three of the first [`MAX_POINTS`] points that have every point (all of them) on one
+    /// side.
     pub fn of_points(near: &[Vec3], light: &[Vec3], tol: f32) -> Shaft {
         let bounds = Aabb::from_points(near.iter().chain(light)).expanded(tol);
-        let pts = if near.len() + light.len() <= MAX_POINTS {
-            near.iter().chain(light).map(|p| p.as_dvec3()).collect()
-        } else {
-            Vec::new()
-        };
+        let pts: Vec<DVec3> = near.iter().chain(light).map(|p| p.as_dvec3()).collect();
         Shaft::hull(pts, bounds, tol)
     }
 
-    /// The supporting planes of the hull of `pts`, moved out by `tol`, and the planes of `bounds`.
+    /// The supporting planes through three of the first [`MAX_POINTS`] of `pts` with all of `pts`
+    /// on one side, moved out by `tol`, and the planes of `bounds`.
     fn hull(pts: Vec<DVec3>, bounds: Aabb, tol: f32) -> Shaft {
         let tol = tol as f64;
         let scale = pts.iter().fold(0.0f64, |m, p| m.max(p.abs().max_element())).max(1e-30);
         let mut planes: Vec<Plane> = Vec::new();
-        let n = pts.len();
+        let n = pts.len().min(MAX_POINTS);
         for i in 0..n {
             for j in i + 1..n {
                 for k in j + 1..n {
@@ -218,5 +214,30 @@ mod tests {
         let s = Shaft::new(&unit_face(), &light, 1e-5);
         let on = [Vec3::new(2.0, 0.5, 0.5), Vec3::new(2.0, 1.5, 0.5), Vec3::new(2.0, 1.0, 0.7)];
         assert!(s.clips_triangle(&on));
+    }
+
+    /// A light of 24 vertices (more than `MAX_POINTS` with the face): every vertex, the ones past
+    /// the first sixteen points included, lies inside every plane, and so do the segments to them.
+    #[test]
+    fn a_light_with_many_vertices_stays_inside_its_shaft() {
+        let light: Vec<Vec3> = (0..24)
+            .map(|k| {
+                let a = k as f32 / 24.0 * std::f32::consts::TAU;
+                Vec3::new(2.5 + 1.5 * a.cos(), 5.0, 2.5 + 1.5 * a.sin())
+            })
+            .collect();
+        let s = Shaft::new(&unit_face(), &light, 1e-5);
+        for f in unit_face() {
+            for &l in &light {
+                for i in 0..=10 {
+                    let p = (f + (l - f) * (i as f32 / 10.0)).as_dvec3();
+                    assert!(s.planes.iter().all(|pl| pl.distance(p) <= 1e-5), "{p}");
+                }
+            }
+        }
+        // A small blocker on the segment from a face corner to the last vertex is kept.
+        let p = unit_face()[0] + (light[23] - unit_face()[0]) * 0.98;
+        let near = [p, p + Vec3::new(0.001, 0.0, 0.0), p + Vec3::new(0.0, 0.0, 0.001)];
+        assert!(s.clips_triangle(&near));
     }
 }

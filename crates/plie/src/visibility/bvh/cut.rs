@@ -229,8 +229,9 @@ mod tests {
             let b = Aabb { min: p, max: p + size * (0.01 + 0.1 * rnd()) };
             let li = (rnd() * scene.lights.len() as f32) as usize % scene.lights.len();
             let light = &scene.lights[li];
-            let corners: Vec<Vec3> =
-                (0..8).map(|k| Vec3::select(glam::BVec3::new(k & 1 != 0, k & 2 != 0, k & 4 != 0), b.max, b.min)).collect();
+            let corners: Vec<Vec3> = (0..8)
+                .map(|k| Vec3::select(glam::BVec3::new(k & 1 != 0, k & 2 != 0, k & 4 != 0), b.max, b.min))
+                .collect();
             let pad = scene.scale() * 1e-5;
             let region = Aabb::from_points(light.vertices.iter().chain(&corners)).expanded(pad);
             let shaft = Shaft::of_points(&corners, &light.vertices, pad);
@@ -243,7 +244,13 @@ mod tests {
                     v[0] + (v[1] - v[0]) * s + (v[v.len() - 1] - v[0]) * t * (1.0 - s)
                 })
                 .collect();
-            let rays = LightRays { origin: x, origin_tri: TriId(u32::MAX), leaf: None, light: LightId(li as u32), targets: &targets };
+            let rays = LightRays {
+                origin: x,
+                origin_tri: TriId(u32::MAX),
+                leaf: None,
+                light: LightId(li as u32),
+                targets: &targets,
+            };
             let mut answers = [[false; 32]; 2];
             for (k, from) in [Some(&cut), None].into_iter().enumerate() {
                 fan.set(&rays);
