@@ -144,28 +144,16 @@ impl Bvh {
             let culled = fan.pyramid.culls_rel8(&los, &his);
             let filled = node.child_meta.iter().enumerate().fold(0u8, |b, (c, &m)| b | u8::from(m != 0) << c);
             let hit = fan.meets8(&los, &his, filled & !culled, node_mask, child_masks, ctx);
-            let slot = |c: usize| Child::of(node, c);
-            let done = self.take_children(
-                prims,
-                scene,
-                rays,
-                fan,
-                out,
-                ctx,
-                (hit, &los, &his, slot),
-                toward,
-                nodes,
-                masks,
-                child_masks,
-            );
-            if done {
+            let at = (hit, &los, &his, |c: usize| Child::of(node, c));
+            if self.take_children(prims, scene, rays, fan, out, ctx, at, toward, nodes, masks, child_masks) {
                 return;
             }
         }
     }
-    /// The children `hit` of a visit (child `c` being slot `slot(c).1` of node `slot(c).0`, its box
-    /// `los`/`his` relative to the apex, its rays in `child_masks`): a leaf's triangles are tested
-    /// against its rays, inner nodes pushed nearest first. True once every ray is closed.
+
+    /// The children `hit` of a visit (child `c` leading to `child_of(c)`, its box `los`/`his`
+    /// relative to the apex, its rays in `child_masks`): a leaf's triangles are tested against its
+    /// rays, inner nodes pushed nearest first. True once every ray is closed.
     #[allow(clippy::too_many_arguments)]
     #[inline(always)]
     fn take_children<P: Prims>(
