@@ -51,6 +51,11 @@ impl Aabb {
         Aabb { min: self.min - Vec3::splat(d), max: self.max + Vec3::splat(d) }
     }
 
+    /// The eight corners (bit 0 of the index picks `max.x`, bit 1 `max.y`, bit 2 `max.z`).
+    pub fn corners(&self) -> [Vec3; 8] {
+        std::array::from_fn(|k| Vec3::select(glam::BVec3::new(k & 1 != 0, k & 2 != 0, k & 4 != 0), self.max, self.min))
+    }
+
     /// Center point.
     pub fn center(&self) -> Vec3 {
         (self.min + self.max) * 0.5

@@ -2,7 +2,7 @@
 //! leaf and a light, at most [`CUT_MAX`] children of BVH nodes whose boxes hold every triangle box
 //! that meets the hull of the leaf's box and the light polygon. A fan from a point of the leaf to the
 //! light lies inside that hull, so testing the cut's boxes as the children of one node
-//! ([`super::Bvh::fan_occluded_from`]) reaches every triangle a walk from the root would, without
+//! ([`super::Bvh::fan_occluded`]) reaches every triangle a walk from the root would, without
 //! visiting the nodes above the cut.
 //!
 //! The cut is chosen greedily: the root's children that meet the region, then the inner child with
@@ -14,6 +14,7 @@ use glam::Vec3;
 use obvhs::cwbvh::node::CwBvhNode;
 
 use super::{Bvh, PAD};
+use crate::construct::shaft::Shaft;
 use crate::geometry::Aabb;
 
 /// Most entries of a cut: one node's worth of box lanes. Measured (callgrind at 64 rays): 16 cost
@@ -61,10 +62,19 @@ pub(crate) struct Cut {
 }
 
 impl Bvh {
+    /// The cut of the hull of the box `b` and the light polygon `light`, grown by `pad`: the hull
+    /// holds every segment from a point of `b` to a point of the light.
+    pub(crate) fn cut_of(&self, b: &Aabb, light: &[Vec3], pad: f32) -> Cut {
+        let corners = b.corners();
+        let region = Aabb::from_points(light.iter().chain(&corners)).expanded(pad);
+        let shaft = Shaft::of_points(&corners, light, pad);
+        self.cut(&region, |b| shaft.may_overlap_box(b))
+    }
+
     /// The cut of the region `region` (world units; see the module documentation), keeping only the
     /// children whose boxes (in world units, grown by twice the padding) `keep` accepts: `keep` must
     /// accept every box that meets a segment of the fans the cut serves. An empty BVH has an empty cut.
-    pub(crate) fn cut(&self, region: &Aabb, keep: impl Fn(&Aabb) -> bool) -> Cut {
+    fn cut(&self, region: &Aabb, keep: impl Fn(&Aabb) -> bool) -> Cut {
         let mut cut = Cut::default();
         if self.cw.nodes.is_empty() {
             return cut;
@@ -87,12 +97,12 @@ impl Bvh {
         let mut entries: Vec<(u32, u8)> = children(0).map(|c| (0, c as u8)).collect();
         // Inner entries too wide to expand within the limit.
         let mut stuck: Vec<(u32, u8)> = Vec::new();
+        let area = |&(p, c): &(u32, u8)| {
+            let (a, b) = self.child_box(p, c as usize);
+            let d = b - a;
+            d.x * d.y + d.y * d.z + d.z * d.x
+        };
         loop {
-            let area = |&(p, c): &(u32, u8)| {
-                let (a, b) = self.child_box(p, c as usize);
-                let d = b - a;
-                d.x * d.y + d.y * d.z + d.z * d.x
-            };
             let next = entries
                 .iter()
                 .enumerate()
@@ -146,6 +156,14 @@ mod tests {
     use crate::render::sampler::mix64;
     use crate::visibility::bvh::Bvh;
 
+    /// Uniform numbers in [0, 1) from `seed`.
+    fn uniform(mut state: u64) -> impl FnMut() -> f32 {
+        move || {
+            state = mix64(state);
+            (state >> 40) as f32 / (1u64 << 24) as f32
+        }
+    }
+
     /// Every triangle whose box meets the hull of a random box and a light lies under the cut of
     /// that hull, and the cut has at most `CUT_MAX` entries.
     #[test]
@@ -153,23 +171,18 @@ mod tests {
         let scene = crate::scene::builtin::load("huis-c").unwrap();
         let bvh = Bvh::build(&scene);
         let (lo, size) = (scene.bounds.min, scene.bounds.max - scene.bounds.min);
-        let mut state = 11u64;
-        let mut rnd = || {
-            state = mix64(state);
-            (state >> 40) as f32 / (1u64 << 24) as f32
-        };
+        let mut rnd = uniform(11);
         let mut deeper = 0;
         for _ in 0..300 {
             let p = lo + size * Vec3::new(rnd(), rnd(), rnd());
             let b = Aabb { min: p, max: p + size * (0.02 + 0.2 * rnd()) };
             let light = &scene.lights[(rnd() * scene.lights.len() as f32) as usize % scene.lights.len()].vertices;
-            let corners: Vec<Vec3> = (0..8)
-                .map(|k| Vec3::select(glam::BVec3::new(k & 1 != 0, k & 2 != 0, k & 4 != 0), b.max, b.min))
-                .collect();
             let pad = scene.scale() * 1e-5;
+            let cut = bvh.cut_of(&b, light, pad);
+            // The hull, to check against.
+            let corners = b.corners();
             let region = Aabb::from_points(light.iter().chain(&corners)).expanded(pad);
             let shaft = Shaft::of_points(&corners, light, pad);
-            let cut = bvh.cut(&region, |b| shaft.may_overlap_box(b));
             assert!(cut.len as usize <= super::CUT_MAX);
             // The triangles under the cut.
             let mut under = vec![false; scene.triangles.len()];
@@ -216,11 +229,7 @@ mod tests {
         let bvh = Bvh::build(&scene);
         let brute = Brute::new(&scene);
         let (lo, size) = (scene.bounds.min, scene.bounds.max - scene.bounds.min);
-        let mut state = 5u64;
-        let mut rnd = || {
-            state = mix64(state);
-            (state >> 40) as f32 / (1u64 << 24) as f32
-        };
+        let mut rnd = uniform(5);
         let mut ctx = QueryCtx::new(scene.triangles.len());
         let (mut fan, mut walk) = (Fan::default(), WalkStack::default());
         let (mut occluded, mut total) = (0, 0);
@@ -229,13 +238,7 @@ mod tests {
             let b = Aabb { min: p, max: p + size * (0.01 + 0.1 * rnd()) };
             let li = (rnd() * scene.lights.len() as f32) as usize % scene.lights.len();
             let light = &scene.lights[li];
-            let corners: Vec<Vec3> = (0..8)
-                .map(|k| Vec3::select(glam::BVec3::new(k & 1 != 0, k & 2 != 0, k & 4 != 0), b.max, b.min))
-                .collect();
-            let pad = scene.scale() * 1e-5;
-            let region = Aabb::from_points(light.vertices.iter().chain(&corners)).expanded(pad);
-            let shaft = Shaft::of_points(&corners, &light.vertices, pad);
-            let cut = bvh.cut(&region, |b| shaft.may_overlap_box(b));
+            let cut = bvh.cut_of(&b, &light.vertices, scene.scale() * 1e-5);
             let x = b.min + (b.max - b.min) * Vec3::new(rnd(), rnd(), rnd());
             let v = &light.vertices;
             let targets: Vec<Vec3> = (0..32)
@@ -255,7 +258,7 @@ mod tests {
             for (k, from) in [Some(&cut), None].into_iter().enumerate() {
                 fan.set(&rays);
                 fan.pyramid.set_in(&scene, x, rays.light);
-                bvh.fan_occluded_from(from, &scene, &rays, &mut fan, &mut walk, &mut answers[k], &mut ctx);
+                bvh.fan_occluded(from, &scene, &rays, &mut fan, &mut walk, &mut answers[k], &mut ctx);
             }
             assert_eq!(answers[0], answers[1], "cut against root");
             for (k, &a) in answers[0].iter().enumerate() {

@@ -28,25 +28,12 @@ use crate::visibility::{LightRays, QueryCtx};
 
 impl Bvh {
     /// Tests the fan's open rays against every triangle of `scene` (but each ray's own: the
-    /// origin triangle and the light's), walking the BVH with all of them at once. Each ray a
-    /// triangle blocks gets `out[k]` set and is closed in the fan. The caller has set the fan's
-    /// pyramid for this light.
-    pub(crate) fn fan_occluded(
-        &self,
-        scene: &Scene,
-        rays: &LightRays,
-        fan: &mut Fan,
-        walk: &mut WalkStack,
-        out: &mut [bool],
-        ctx: &mut QueryCtx,
-    ) {
-        self.fan_occluded_from(None, scene, rays, fan, walk, out, ctx);
-    }
-
-    /// [`Bvh::fan_occluded`], starting from `cut` (see [`Bvh::cut`]) instead of the root when given:
-    /// the cut of a region that holds every segment of the fan.
+    /// origin triangle and the light's), walking the BVH with all of them at once, from `cut` (see
+    /// [`Bvh::cut_of`]: the cut of a region that holds every segment of the fan) or else from the
+    /// root. Each ray a triangle blocks gets `out[k]` set and is closed in the fan. The caller has
+    /// set the fan's pyramid for this light.
     #[allow(clippy::too_many_arguments)]
-    pub(crate) fn fan_occluded_from(
+    pub(crate) fn fan_occluded(
         &self,
         cut: Option<&Cut>,
         scene: &Scene,

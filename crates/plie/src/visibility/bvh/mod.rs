@@ -223,7 +223,7 @@ impl Visibility for BvhVisibility<'_> {
         out.fill(false);
         sc.fan.set(rays);
         sc.fan.pyramid.set_in(self.scene, rays.origin, rays.light);
-        self.bvh.fan_occluded(self.scene, rays, &mut sc.fan, &mut sc.walk, out, ctx);
+        self.bvh.fan_occluded(None, self.scene, rays, &mut sc.fan, &mut sc.walk, out, ctx);
         ctx.light = sc;
     }
 }

@@ -5,7 +5,7 @@
 //! ([`super::super::fan`]) with the leaf's own triangles. Any other light (footprints over penumbra
 //! and umbra alike, long lists, records that store no list, a leaf crowded with triangles of its
 //! own) is answered by the scene BVH, all samples at once, starting from the cut of the leaf and the
-//! light (`Bvh::fan_occluded_from`, [`crate::visibility::bvh::Cut`]): measured, that beat
+//! light (`Bvh::fan_occluded`, [`crate::visibility::bvh::Cut`]): measured, that beat
 //! finding each sample's exit face, record and cell and testing its own list on every scene tried
 //! (docs/results.md, session 8).
 
@@ -100,7 +100,7 @@ impl LieVisibility<'_> {
         // The cut holds every triangle a segment from the leaf to the light can meet.
         debug_assert!(self.octree.leaf_bounds(leaf).expanded(self.scene.scale() * 1e-5).contains(rays.origin));
         let cut = self.cuts.get(leaf.idx() * self.scene.lights.len() + rays.light.idx());
-        self.bvh.fan_occluded_from(cut, self.scene, rays, &mut sc.fan, &mut sc.walk, out, ctx);
+        self.bvh.fan_occluded(cut, self.scene, rays, &mut sc.fan, &mut sc.walk, out, ctx);
         ctx.stats.blocker_tests += ctx.stats.triangle_tests - before;
         ctx.stats.answers.count_n(Answer::SceneBvh, out.len());
     }

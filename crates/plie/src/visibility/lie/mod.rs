@@ -29,9 +29,8 @@ use super::bvh::{segment_occluded, Bvh, Cut};
 use super::leaf_voxels::LeafVoxels;
 use super::list_boxes::{Chunked, ListBoxes, ListVisitor};
 use super::{blocks, Answer, LightRays, Mode, OctreeVisibility, QueryCtx, ShadowRay, Visibility};
-use glam::{BVec3, Vec3};
+use glam::Vec3;
 
-use crate::construct::shaft::Shaft;
 use crate::geometry::{Aabb, Segment};
 use crate::lie::frame::{in_triangles, FaceFrame};
 use crate::lie::grid;
@@ -73,7 +72,7 @@ pub struct LieVisibility<'a> {
     /// counted in four lookups.
     sat: Vec<[u32; 3]>,
     /// Per (leaf, light), `leaf * lights + light`: where the scene BVH's walk starts for a light
-    /// answered by the scene ([`Bvh::cut`] of the hull of the leaf and the light). Empty when they
+    /// answered by the scene ([`Bvh::cut_of`] the leaf and the light). Empty when they
     /// would take too much memory: the walks then start at the root.
     cuts: Vec<Cut>,
 }
@@ -181,13 +180,7 @@ fn leaf_cuts(scene: &Scene, octree: &Octree, bvh: &Bvh, pad: f32) -> Vec<Cut> {
         .par_iter()
         .flat_map_iter(|&leaf| {
             let b = octree.leaf_bounds(leaf);
-            let corners: [Vec3; 8] =
-                std::array::from_fn(|k| Vec3::select(BVec3::new(k & 1 != 0, k & 2 != 0, k & 4 != 0), b.max, b.min));
-            scene.lights.iter().map(move |l| {
-                let region = Aabb::from_points(l.vertices.iter().chain(&corners)).expanded(pad);
-                let shaft = Shaft::of_points(&corners, &l.vertices, pad);
-                bvh.cut(&region, |b| shaft.may_overlap_box(b))
-            })
+            scene.lights.iter().map(move |l| bvh.cut_of(&b, &l.vertices, pad))
         })
         .collect()
 }
