@@ -99,7 +99,7 @@ impl LieVisibility<'_> {
         let before = ctx.stats.triangle_tests;
         // The cut holds every triangle a segment from the leaf to the light can meet.
         debug_assert!(self.octree.leaf_bounds(leaf).expanded(self.scene.scale() * 1e-5).contains(rays.origin));
-        let cut = self.cuts.get(leaf.idx() * self.scene.lights.len() + rays.light.idx());
+        let cut = self.cut(leaf, rays.light);
         self.bvh.fan_occluded(cut, self.scene, rays, &mut sc.fan, &mut sc.walk, out, ctx);
         ctx.stats.blocker_tests += ctx.stats.triangle_tests - before;
         ctx.stats.answers.count_n(Answer::SceneBvh, out.len());

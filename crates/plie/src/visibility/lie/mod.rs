@@ -36,7 +36,8 @@ use crate::lie::frame::{in_triangles, FaceFrame};
 use crate::lie::grid;
 use crate::lie::{Cell, Plie, RecordKind};
 use crate::octree::{Dir, LeafId, Octree};
-use crate::scene::{Scene, TriId};
+use crate::scene::{LightId, Scene, TriId};
+use std::sync::OnceLock;
 
 /// Modes (b)-(d) and `grid`: the P-LIE's blocker lists, regions and face grids.
 ///
@@ -72,9 +73,11 @@ pub struct LieVisibility<'a> {
     /// counted in four lookups.
     sat: Vec<[u32; 3]>,
     /// Per (leaf, light), `leaf * lights + light`: where the scene BVH's walk starts for a light
-    /// answered by the scene ([`Bvh::cut_of`] the leaf and the light). Empty when they
-    /// would take too much memory: the walks then start at the root.
-    cuts: Vec<Cut>,
+    /// answered by the scene ([`Bvh::cut_of`] the leaf and the light), computed on first use. Empty
+    /// when the table would take too much memory: the walks then start at the root.
+    cuts: Vec<OnceLock<Box<Cut>>>,
+    /// The scene tolerance the cuts' hulls are grown by.
+    pad: f32,
 }
 
 impl<'a> LieVisibility<'a> {
@@ -102,7 +105,7 @@ impl<'a> LieVisibility<'a> {
         }
         let own_boxes = ListBoxes::new(own.iter().copied(), &own_tris, &tri_boxes);
         let (sat_start, sat) = if mode == Mode::Grid { whole::grid_tables(plie) } else { (Vec::new(), Vec::new()) };
-        let cuts = leaf_cuts(scene, octree, bvh, pad);
+        let cuts = cut_table(scene, octree);
         LieVisibility {
             scene,
             octree,
@@ -119,6 +122,7 @@ impl<'a> LieVisibility<'a> {
             sat_start,
             sat,
             cuts,
+            pad,
         }
     }
 
@@ -164,29 +168,35 @@ pub fn exit_face(octree: &Octree, leaf: LeafId, ray: &ShadowRay) -> Option<(Dir,
     exit_face_of(&octree.leaf_bounds(leaf), ray.test.origin, ray.test.dir, ray.test.t_max)
 }
 
-/// The cut of the scene BVH for every (leaf, light), at `leaf * lights + light`: the children
-/// whose boxes meet the hull of the leaf's box and the light polygon (grown by `pad`), which holds
-/// every segment from a point of the leaf to a point of the light. None (every walk starts at the
-/// root) when they would take more than [`CUTS_MAX_BYTES`].
-fn leaf_cuts(scene: &Scene, octree: &Octree, bvh: &Bvh, pad: f32) -> Vec<Cut> {
-    use rayon::prelude::*;
-    let bytes =
-        (octree.leaf_count() as u64 * scene.lights.len() as u64).saturating_mul(std::mem::size_of::<Cut>() as u64);
-    if bytes > CUTS_MAX_BYTES {
+/// The empty table of the cuts of the scene BVH, one slot per (leaf, light) at
+/// `leaf * lights + light` ([`LieVisibility::cut`]), or no table (every walk starts at the root) when
+/// its slots would take more than [`CUTS_MAX_BYTES`].
+fn cut_table(scene: &Scene, octree: &Octree) -> Vec<OnceLock<Box<Cut>>> {
+    let pairs = octree.leaf_count() as u64 * scene.lights.len() as u64;
+    if pairs.saturating_mul(std::mem::size_of::<OnceLock<Box<Cut>>>() as u64) > CUTS_MAX_BYTES {
         return Vec::new();
     }
-    let leaves: Vec<LeafId> = octree.leaves().collect();
-    leaves
-        .par_iter()
-        .flat_map_iter(|&leaf| {
-            let b = octree.leaf_bounds(leaf);
-            scene.lights.iter().map(move |l| bvh.cut_of(&b, &l.vertices, pad))
-        })
-        .collect()
+    (0..pairs).map(|_| OnceLock::new()).collect()
 }
 
-/// Most bytes the cuts of a P-LIE's (leaf, light) pairs may take (about 290 a pair): 256 MiB.
+/// Most bytes the slots of the cut table may take (16 a (leaf, light) pair; a cut computed takes
+/// about 300 more): 256 MiB.
 const CUTS_MAX_BYTES: u64 = 256 << 20;
+
+impl LieVisibility<'_> {
+    /// The cut of the scene BVH for `leaf` and `light`: the children whose boxes meet the hull of
+    /// the leaf's box and the light polygon (grown by the scene tolerance), which holds every segment
+    /// from a point of the leaf to a point of the light. Computed on first use (any thread computes
+    /// the same cut); `None` without a cut table.
+    #[inline]
+    fn cut(&self, leaf: LeafId, light: LightId) -> Option<&Cut> {
+        let slot = self.cuts.get(leaf.idx() * self.scene.lights.len() + light.idx())?;
+        Some(slot.get_or_init(|| {
+            let b = self.octree.leaf_bounds(leaf);
+            Box::new(self.bvh.cut_of(&b, &self.scene.lights[light.idx()].vertices, self.pad))
+        }))
+    }
+}
 
 /// [`exit_face`] for the box `b` and the segment `o + t d`, `t < t_max`.
 #[inline]
