@@ -81,10 +81,16 @@ impl Shaft {
                     let nn = normal / len;
                     let d = nn.dot(pts[i]);
                     let slack = 1e-9 * scale;
-                    let (lo, hi) = pts.iter().fold((f64::MAX, f64::MIN), |(lo, hi), p| {
+                    // The points' least and greatest distances, stopping once they lie on both
+                    // sides (then the plane is no face of the hull).
+                    let (mut lo, mut hi) = (f64::MAX, f64::MIN);
+                    for p in &pts {
                         let s = nn.dot(*p) - d;
-                        (lo.min(s), hi.max(s))
-                    });
+                        (lo, hi) = (lo.min(s), hi.max(s));
+                        if lo < -slack && hi > slack {
+                            break;
+                        }
+                    }
                     let cand = if hi <= slack {
                         Plane { n: nn, d: d + hi.max(0.0) }
                     } else if lo >= -slack {

@@ -152,8 +152,9 @@ impl std::ops::AddAssign for QueryStats {
 pub struct QueryCtx {
     /// Counters.
     pub stats: QueryStats,
-    /// Scratch of the per-light queries.
-    pub(crate) light: super::fan::LightScratch,
+    /// Scratch of the per-light queries, taken out while one runs (moving a pointer, not the
+    /// scratch itself; `None` until the first).
+    pub(crate) light: Option<Box<super::fan::LightScratch>>,
     stamps: Vec<u32>,
     stamp: u32,
 }
@@ -161,7 +162,7 @@ pub struct QueryCtx {
 impl QueryCtx {
     /// A context for a scene with `triangles` triangles.
     pub fn new(triangles: usize) -> QueryCtx {
-        QueryCtx { stats: QueryStats::default(), light: Default::default(), stamps: vec![0; triangles], stamp: 0 }
+        QueryCtx { stats: QueryStats::default(), light: None, stamps: vec![0; triangles], stamp: 0 }
     }
 
     /// Starts a new query: every triangle counts as unvisited again.

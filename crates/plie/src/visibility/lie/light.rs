@@ -66,7 +66,7 @@ impl LieVisibility<'_> {
             }
             return;
         };
-        let mut scratch = std::mem::take(&mut ctx.light);
+        let mut scratch = ctx.light.take().unwrap_or_default();
         let sc = &mut scratch;
         let bounds = self.octree.leaf_bounds(leaf);
         sc.lists.clear();
@@ -86,7 +86,7 @@ impl LieVisibility<'_> {
             Whole::Lists => self.lists_only(leaf, rays, sc, out, ctx),
             Whole::Mixed => self.by_scene(leaf, rays, sc, out, ctx),
         }
-        ctx.light = scratch;
+        ctx.light = Some(scratch);
     }
 
     /// [`Whole::Mixed`]: every sample down the scene BVH at once, for the whole segment, from the
