@@ -165,6 +165,16 @@ impl QueryCtx {
         QueryCtx { stats: QueryStats::default(), light: None, stamps: vec![0; triangles], stamp: 0 }
     }
 
+    /// Runs `f` with the per-light scratch, taken out of the context (a pointer moved) so that `f`
+    /// can use both, and put back after.
+    #[inline]
+    pub(crate) fn with_light<R>(&mut self, f: impl FnOnce(&mut super::fan::LightScratch, &mut QueryCtx) -> R) -> R {
+        let mut sc = self.light.take().unwrap_or_default();
+        let r = f(&mut sc, self);
+        self.light = Some(sc);
+        r
+    }
+
     /// Starts a new query: every triangle counts as unvisited again.
     #[inline]
     pub fn begin_query(&mut self) {

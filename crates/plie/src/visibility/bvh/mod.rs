@@ -219,12 +219,12 @@ impl Visibility for BvhVisibility<'_> {
             }
             return;
         }
-        let mut sc = ctx.light.take().unwrap_or_default();
-        out.fill(false);
-        sc.fan.set(rays);
-        sc.fan.pyramid.set_in(self.scene, rays.origin, rays.light);
-        self.bvh.fan_occluded(None, self.scene, rays, &mut sc.fan, &mut sc.walk, out, ctx);
-        ctx.light = Some(sc);
+        ctx.with_light(|sc, ctx| {
+            out.fill(false);
+            sc.fan.set(rays);
+            sc.fan.pyramid.set_in(self.scene, rays.origin, rays.light);
+            self.bvh.fan_occluded(None, self.scene, rays, &mut sc.fan, &mut sc.walk, out, ctx);
+        });
     }
 }
 

@@ -66,27 +66,26 @@ impl LieVisibility<'_> {
             }
             return;
         };
-        let mut scratch = ctx.light.take().unwrap_or_default();
-        let sc = &mut scratch;
-        let bounds = self.octree.leaf_bounds(leaf);
-        sc.lists.clear();
-        sc.ranges.clear();
-        ctx.stats.lights.queries += 1;
-        match self.whole_light(leaf, &bounds, rays, &self.scene.lights[rays.light.idx()].vertices, sc) {
-            Whole::Umbra => {
-                out.fill(true);
-                ctx.stats.lights.whole_umbra += 1;
-                ctx.stats.answers.count_n(Answer::Umbra, out.len());
+        ctx.with_light(|sc, ctx| {
+            let bounds = self.octree.leaf_bounds(leaf);
+            sc.lists.clear();
+            sc.ranges.clear();
+            ctx.stats.lights.queries += 1;
+            match self.whole_light(leaf, &bounds, rays, &self.scene.lights[rays.light.idx()].vertices, sc) {
+                Whole::Umbra => {
+                    out.fill(true);
+                    ctx.stats.lights.whole_umbra += 1;
+                    ctx.stats.answers.count_n(Answer::Umbra, out.len());
+                }
+                // A leaf with many triangles of its own: the BVH culls them better than the fan does.
+                Whole::Lit | Whole::Lists if self.own[leaf.idx()].1 as usize > OWN_MAX => {
+                    self.by_scene(leaf, rays, sc, out, ctx)
+                }
+                Whole::Lit => self.own_only(leaf, rays, sc, out, ctx),
+                Whole::Lists => self.lists_only(leaf, rays, sc, out, ctx),
+                Whole::Mixed => self.by_scene(leaf, rays, sc, out, ctx),
             }
-            // A leaf with many triangles of its own: the BVH culls them better than the fan does.
-            Whole::Lit | Whole::Lists if self.own[leaf.idx()].1 as usize > OWN_MAX => {
-                self.by_scene(leaf, rays, sc, out, ctx)
-            }
-            Whole::Lit => self.own_only(leaf, rays, sc, out, ctx),
-            Whole::Lists => self.lists_only(leaf, rays, sc, out, ctx),
-            Whole::Mixed => self.by_scene(leaf, rays, sc, out, ctx),
-        }
-        ctx.light = Some(scratch);
+        });
     }
 
     /// [`Whole::Mixed`]: every sample down the scene BVH at once, for the whole segment, from the
