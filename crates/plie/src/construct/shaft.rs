@@ -81,16 +81,10 @@ impl Shaft {
                     let nn = normal / len;
                     let d = nn.dot(pts[i]);
                     let slack = 1e-9 * scale;
-                    // The points' least and greatest distances, stopping once they lie on both
-                    // sides (then the plane is no face of the hull).
-                    let (mut lo, mut hi) = (f64::MAX, f64::MIN);
-                    for p in &pts {
+                    let (lo, hi) = pts.iter().fold((f64::MAX, f64::MIN), |(lo, hi), p| {
                         let s = nn.dot(*p) - d;
-                        (lo, hi) = (lo.min(s), hi.max(s));
-                        if lo < -slack && hi > slack {
-                            break;
-                        }
-                    }
+                        (lo.min(s), hi.max(s))
+                    });
                     let cand = if hi <= slack {
                         Plane { n: nn, d: d + hi.max(0.0) }
                     } else if lo >= -slack {
