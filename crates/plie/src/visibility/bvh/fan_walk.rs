@@ -129,7 +129,7 @@ impl Bvh {
                 }
             }
             let culled = fan.pyramid.culls_rel8(&los, &his);
-            let filled = node.child_meta.iter().enumerate().fold(0u8, |b, (c, &m)| b | u8::from(m != 0) << c);
+            let filled = nonzero_bytes(node.child_meta);
             let hit = fan.meets8(&los, &his, filled & !culled, node_mask, child_masks, ctx);
             let at = (hit, &los, &his, |c: usize| Child::of(node, c));
             if self.take_children(prims, scene, rays, fan, out, ctx, at, toward, nodes, masks, child_masks) {
@@ -201,5 +201,34 @@ impl Bvh {
             }
         }
         false
+    }
+}
+
+/// Bit `c` set where byte `c` of `bytes` is not zero.
+#[inline(always)]
+fn nonzero_bytes(bytes: [u8; 8]) -> u8 {
+    let m = u64::from_le_bytes(bytes);
+    const LOW7: u64 = 0x7f7f_7f7f_7f7f_7f7f;
+    // The top bit of each byte: set where the byte is not zero.
+    let top = ((m & LOW7) + LOW7 | m) & !LOW7;
+    // Gathers the eight top bits into the top byte.
+    ((top >> 7).wrapping_mul(0x0102_0408_1020_4080) >> 56) as u8
+}
+
+#[cfg(test)]
+mod tests {
+    use super::nonzero_bytes;
+
+    /// The nonzero-byte mask of every pattern of zero and nonzero bytes (with several nonzero values).
+    #[test]
+    fn nonzero_bytes_marks_every_nonzero_byte() {
+        for pattern in 0..=255u8 {
+            for value in [1u8, 0x7f, 0x80, 0xff, 0x24] {
+                let bytes: [u8; 8] =
+                    std::array::from_fn(|c| if pattern >> c & 1 != 0 { value.rotate_left(c as u32) } else { 0 });
+                let want = bytes.iter().enumerate().fold(0u8, |b, (c, &m)| b | u8::from(m != 0) << c);
+                assert_eq!(nonzero_bytes(bytes), want, "{bytes:?}");
+            }
+        }
     }
 }

@@ -99,9 +99,11 @@ impl Fan {
             self.maybe.resize(words, 0);
         }
         let [dx, dy, dz, len, sz, ix, iy, iz] = &mut self.all;
-        for (k, y) in rays.targets.iter().enumerate() {
+        // Over slices, so that the loop reads and writes without bounds checks.
+        let (dx, dy, dz) = (&mut dx[..n], &mut dy[..n], &mut dz[..n]);
+        for (((y, dx), dy), dz) in rays.targets.iter().zip(dx.iter_mut()).zip(dy.iter_mut()).zip(dz.iter_mut()) {
             let d = *y - x;
-            (dx[k], dy[k], dz[k]) = (d.x, d.y, d.z);
+            (*dx, *dy, *dz) = (d.x, d.y, d.z);
         }
         let kzs = &mut self.all_kz[..n];
         let mut done = 0;
@@ -272,8 +274,14 @@ impl Fan {
                 ctx.stats.box_tests += u64::from(f.count_ones() * alive.count_ones());
                 meets_boxes(lo, hi, alive, &lanes, i * 64, f, &mut out);
             }
+            if w == 1 {
+                to[..8].copy_from_slice(&out);
+            } else {
+                for (c, &o) in out.iter().enumerate() {
+                    to[c * w + i] = o;
+                }
+            }
             for (c, &o) in out.iter().enumerate() {
-                to[c * w + i] = o;
                 hit |= u8::from(o != 0) << c;
             }
         }
@@ -352,7 +360,8 @@ impl Fan {
         // (computed as it computes them); lanes where all of them lie outside the segment's range
         // (beyond a margin for the mean's rounding) miss. Per axis, the least and greatest vertex
         // coordinate.
-        let span = [0, 1, 2].map(|k| (a[k].min(b[k]).min(c[k]), a[k].max(b[k]).max(c[k])));
+        let (lo, hi) = (a.min(b).min(c), a.max(b).max(c));
+        let span = [(lo.x, hi.x), (lo.y, hi.y), (lo.z, hi.z)];
         if s.iter().all(|v| v.is_finite()) {
             let [x, y, z, len, sz, ..] = &self.all;
             let lanes = Lanes { x, y, z, len, sz, kz: &self.all_kz };
