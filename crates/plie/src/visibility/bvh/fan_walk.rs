@@ -210,7 +210,7 @@ fn nonzero_bytes(bytes: [u8; 8]) -> u8 {
     let m = u64::from_le_bytes(bytes);
     const LOW7: u64 = 0x7f7f_7f7f_7f7f_7f7f;
     // The top bit of each byte: set where the byte is not zero.
-    let top = ((m & LOW7) + LOW7 | m) & !LOW7;
+    let top = (((m & LOW7) + LOW7) | m) & !LOW7;
     // Gathers the eight top bits into the top byte.
     ((top >> 7).wrapping_mul(0x0102_0408_1020_4080) >> 56) as u8
 }
