@@ -67,8 +67,9 @@ impl Bvh {
     pub(crate) fn cut_of(&self, b: &Aabb, light: &[Vec3], pad: f32) -> Cut {
         let corners = b.corners();
         let region = Aabb::from_points(light.iter().chain(&corners)).expanded(pad);
-        let shaft = Shaft::of_points(&corners, light, pad);
-        self.cut(&region, |b| shaft.may_overlap_box(b))
+        let shaft = Shaft::of_box_and_polygon(b, light, pad);
+        // `cut` keeps only boxes that meet `region`, which holds the shaft's bounds.
+        self.cut(&region, |b| shaft.may_overlap_box_in_bounds(b))
     }
 
     /// The cut of the region `region` (world units; see the module documentation), keeping only the
@@ -182,7 +183,7 @@ mod tests {
             // The hull, to check against.
             let corners = b.corners();
             let region = Aabb::from_points(light.iter().chain(&corners)).expanded(pad);
-            let shaft = Shaft::of_points(&corners, light, pad);
+            let shaft = Shaft::of_box_and_polygon(&b, light, pad);
             assert!(cut.len as usize <= super::CUT_MAX);
             // The triangles under the cut.
             let mut under = vec![false; scene.triangles.len()];
