@@ -252,7 +252,13 @@ impl<'a> Found<'a> {
             let (mut lo, mut hi) = (f64::MAX, f64::MIN);
             for p in pts {
                 let s = nn.dot(*p) - d;
-                (lo, hi) = (lo.min(s), hi.max(s));
+                // Plain comparisons (no value here is NaN: f32 coordinates cannot overflow f64).
+                if s < lo {
+                    lo = s;
+                }
+                if s > hi {
+                    hi = s;
+                }
                 // Points on both sides: not a supporting plane.
                 if lo < -slack && hi > slack {
                     return;
