@@ -67,20 +67,20 @@ impl Shaft {
     /// [`Shaft::of_points`] of the box's corners and the polygon, from fewer candidate planes. Each
     /// facet of that hull is a face of the box, the polygon's plane, or holds an edge of one and a
     /// vertex of the other, so only those triples are tried (106 for a quadrilateral, against 220
-    /// triples of the twelve points); each is kept, as there, only if every point lies on one side. The cuts of the scene BVH use it ([`crate::visibility::bvh::Cut`]).
+    /// triples of the twelve points); each is kept, as there, only if every point lies on one side.
+    /// The cuts of the scene BVH use it ([`crate::visibility::bvh::Cut`]).
     pub fn of_box_and_polygon(b: &Aabb, light: &[Vec3], tol: f32) -> Shaft {
         let corners = b.corners();
         let bounds = Aabb::from_points(light.iter().chain(&corners)).expanded(tol);
         let pts: Vec<DVec3> = corners.iter().chain(light).map(|p| p.as_dvec3()).collect();
         let k = light.len();
         let mut planes = Vec::new();
-        let found = Found::new(&pts);
+        let found = HullPoints::new(&pts);
         // The box's faces: three corners of each (bit `a` of a corner's index is its side on axis `a`).
         for a in 0..3 {
+            let (u, v) = (1 << ((a + 1) % 3), 1 << ((a + 2) % 3));
             for side in [0, 1 << a] {
-                let mut face = (0..8).filter(|c| c & (1 << a) == side);
-                let (i, j, l) = (face.next().unwrap_or(0), face.next().unwrap_or(0), face.next().unwrap_or(0));
-                found.try_plane::<true>(i, j, l, &mut planes);
+                found.try_plane::<true>(side, side | u, side | v, &mut planes);
             }
         }
         // The polygon's vertices, in `f32`, need not lie in one plane: its facets are any three of
@@ -112,7 +112,7 @@ impl Shaft {
     /// on one side, moved out by `tol`, and the planes of `bounds`.
     fn hull(pts: Vec<DVec3>, bounds: Aabb, tol: f32) -> Shaft {
         let mut planes: Vec<Plane> = Vec::new();
-        let found = Found::new(&pts);
+        let found = HullPoints::new(&pts);
         let n = pts.len().min(MAX_POINTS);
         for i in 0..n {
             for j in i + 1..n {
@@ -223,15 +223,15 @@ impl Shaft {
 }
 
 /// The points of a hull and their scale, for trying candidate planes through three of them.
-struct Found<'a> {
+struct HullPoints<'a> {
     pts: &'a [DVec3],
     scale: f64,
 }
 
-impl<'a> Found<'a> {
-    fn new(pts: &'a [DVec3]) -> Found<'a> {
+impl<'a> HullPoints<'a> {
+    fn new(pts: &'a [DVec3]) -> HullPoints<'a> {
         let scale = pts.iter().fold(0.0f64, |m, p| m.max(p.abs().max_element())).max(1e-30);
-        Found { pts, scale }
+        HullPoints { pts, scale }
     }
 
     /// Adds the plane through points `i`, `j`, `k` to `planes`, facing away from the points, if

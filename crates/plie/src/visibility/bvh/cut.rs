@@ -65,11 +65,10 @@ impl Bvh {
     /// The cut of the hull of the box `b` and the light polygon `light`, grown by `pad`: the hull
     /// holds every segment from a point of `b` to a point of the light.
     pub(crate) fn cut_of(&self, b: &Aabb, light: &[Vec3], pad: f32) -> Cut {
-        let corners = b.corners();
-        let region = Aabb::from_points(light.iter().chain(&corners)).expanded(pad);
         let shaft = Shaft::of_box_and_polygon(b, light, pad);
-        // `cut` keeps only boxes that meet `region`, which holds the shaft's bounds.
-        self.cut(&region, |b| shaft.may_overlap_box_in_bounds(b))
+        // The region is the shaft's bounds (the box and the light, grown by `pad`), and `cut` keeps
+        // only boxes that meet it: the supporting planes are left to test.
+        self.cut(&shaft.bounds, |b| shaft.may_overlap_box_in_bounds(b))
     }
 
     /// The cut of the region `region` (world units; see the module documentation), keeping only the
