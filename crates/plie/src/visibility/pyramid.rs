@@ -118,7 +118,7 @@ impl Pyramid {
     /// box `c`), no segment of the pyramid can meet: bit `c` is set if box `c` lies beyond a side
     /// plane (the corner farthest along its normal still beyond it by the margin). Only the side
     /// planes are tested.
-    #[inline]
+    #[inline(always)]
     pub fn culls_rel8(&self, lo: &[[f32; 8]; 3], hi: &[[f32; 8]; 3]) -> u8 {
         #[cfg(target_arch = "x86_64")]
         if std::arch::is_x86_feature_detected!("avx2") {
@@ -141,6 +141,7 @@ impl Pyramid {
     /// order, so the same bits).
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx,avx2")]
+    #[inline]
     unsafe fn culls_rel8_avx(&self, lo: &[[f32; 8]; 3], hi: &[[f32; 8]; 3]) -> u8 {
         use std::arch::x86_64::*;
         let m = _mm256_set1_ps(-self.margin);

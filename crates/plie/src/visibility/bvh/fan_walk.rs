@@ -16,6 +16,9 @@
 //! back to world units relative to the fan's apex; the rounding of that is far below the padding, so
 //! no ray that meets a triangle misses its boxes. Triangles are decided by the fan's exact test, so
 //! every answer is [`super::segment_occluded`]'s, which is brute force's.
+//!
+//! Where the CPU has AVX2, the walk is compiled for it as a whole, so that the fan's lane kernels
+//! inline into it (measured: 4-8% fewer instructions per query, docs/results.md session 13).
 
 use glam::{Vec3, Vec3A};
 
@@ -43,6 +46,46 @@ impl Bvh {
         out: &mut [bool],
         ctx: &mut QueryCtx,
     ) {
+        #[cfg(target_arch = "x86_64")]
+        if std::arch::is_x86_feature_detected!("avx2") {
+            // SAFETY: AVX2 is available (checked above).
+            return unsafe { self.fan_occluded_avx(cut, scene, rays, fan, walk, out, ctx) };
+        }
+        self.fan_occluded_in(cut, scene, rays, fan, walk, out, ctx)
+    }
+
+    /// [`Bvh::fan_occluded`] compiled for AVX2 as a whole, so that the lane kernels (AVX2
+    /// functions) inline into the walk instead of being called per node and triangle. The same
+    /// operations, so the same answers: Rust never fuses a multiply and an add.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx,avx2")]
+    #[allow(clippy::too_many_arguments)]
+    unsafe fn fan_occluded_avx(
+        &self,
+        cut: Option<&Cut>,
+        scene: &Scene,
+        rays: &LightRays,
+        fan: &mut Fan,
+        walk: &mut WalkStack,
+        out: &mut [bool],
+        ctx: &mut QueryCtx,
+    ) {
+        self.fan_occluded_in(cut, scene, rays, fan, walk, out, ctx)
+    }
+
+    /// [`Bvh::fan_occluded`] for the BVH's kind of leaves.
+    #[allow(clippy::too_many_arguments)]
+    #[inline(always)]
+    fn fan_occluded_in(
+        &self,
+        cut: Option<&Cut>,
+        scene: &Scene,
+        rays: &LightRays,
+        fan: &mut Fan,
+        walk: &mut WalkStack,
+        out: &mut [bool],
+        ctx: &mut QueryCtx,
+    ) {
         match &self.groups {
             None => self.fan_walk(cut, &Single, scene, rays, fan, walk, out, ctx),
             Some(g) => self.fan_walk(cut, g, scene, rays, fan, walk, out, ctx),
@@ -50,6 +93,7 @@ impl Bvh {
     }
 
     #[allow(clippy::too_many_arguments)]
+    #[inline(always)]
     fn fan_walk<P: Prims>(
         &self,
         cut: Option<&Cut>,

@@ -224,7 +224,7 @@ pub(super) fn meets_box(lo: Vec3, hi: Vec3, lanes: &BoxLanes, base: usize, withi
 /// [`meets_box`] for each box `c` of eight with bit `c` of `alive` set, given as lanes
 /// (`lo[axis][c]`, `hi[axis][c]`): `out[c]` becomes the bits of `within` whose segments meet box `c`
 /// (0 for the others).
-#[inline]
+#[inline(always)]
 pub(super) fn meets_boxes(
     lo: &[[f32; 8]; 3],
     hi: &[[f32; 8]; 3],
@@ -268,6 +268,7 @@ fn each_box(lo: &[[f32; 8]; 3], hi: &[[f32; 8]; 3], alive: u8, out: &mut [u64; 8
 /// is decided by [`slab_avx`], as in [`meets_box_avx`], so with the same answer.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx,avx2")]
+#[inline]
 pub(super) unsafe fn meets_boxes_by_ray_avx(
     lo: &[[f32; 8]; 3],
     hi: &[[f32; 8]; 3],
@@ -312,6 +313,7 @@ pub(super) unsafe fn meets_boxes_by_ray_avx(
 /// [`meets_boxes`] in one call with AVX2, each box by [`meets_box_avx`].
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx,avx2")]
+#[inline]
 unsafe fn meets_boxes_avx(
     lo: &[[f32; 8]; 3],
     hi: &[[f32; 8]; 3],
@@ -409,6 +411,7 @@ fn misses_scalar(s: &[Vec3; 3], span: &[(f32, f32); 3], lanes: &Lanes, maybe: &m
 /// [`misses`], eight lanes at a time.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx,avx2")]
+#[inline]
 unsafe fn misses_avx(s: &[Vec3; 3], span: &[(f32, f32); 3], lanes: &Lanes, maybe: &mut [u64]) {
     use std::arch::x86_64::*;
     let n = lanes
@@ -489,6 +492,7 @@ pub(super) struct Shear<'a> {
 /// which it recomputes in f64), as bits.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx,avx2")]
+#[inline]
 pub(super) unsafe fn exact_avx(a: Vec3, b: Vec3, c: Vec3, shear: &Shear, base: usize) -> (u8, u8) {
     use std::arch::x86_64::*;
     let n = shear.s.iter().map(|v| v.len()).chain(shear.k.iter().map(|v| v.len())).min().unwrap_or(0);

@@ -181,7 +181,7 @@ impl Fan {
     /// The watertight test of `tri` for the rays `bits` of word `w`: each ray it blocks gets
     /// `out[k]` set and is closed. Blocks of eight rays with two or more to test take the
     /// lane-wide copy of the test ([`lanes::exact_avx`]), which answers as it does.
-    #[inline]
+    #[inline(always)]
     fn exact(&mut self, tri: &Triangle, w: usize, bits: u64, rays: &LightRays, out: &mut [bool], ctx: &mut QueryCtx) {
         if bits == 0 {
             return;
@@ -251,7 +251,7 @@ impl Fan {
     /// ray against the eight boxes where that is cheaper; it never drops a ray whose segment meets
     /// the box). Returns the boxes some ray meets, as bits. Counts a
     /// box test per ray and box tested.
-    #[inline]
+    #[inline(always)]
     pub fn meets8(
         &self,
         lo: &[[f32; 8]; 3],
