@@ -9,7 +9,7 @@
 //! per-ray exit point (`x + d t_exit`, in `f32`), and a face whose plane the light straddles gets the
 //! whole face.
 
-use glam::{DVec3, Vec3};
+use glam::Vec3;
 
 use crate::geometry::Aabb;
 use crate::octree::Dir;
@@ -36,35 +36,44 @@ pub fn footprints(
     eps: f32,
     mut visit: impl FnMut(FaceFootprint) -> bool,
 ) -> Option<bool> {
-    let xd = x.as_dvec3();
+    let xd = [x.x as f64, x.y as f64, x.z as f64];
     // The margin: relative to the coordinates involved, far above f32 rounding (~6e-8 relative).
     let scale = light.iter().fold(x.abs().max_element(), |m, v| m.max(v.abs().max_element())) as f64;
     let margin = 1e-5 * scale.max(f64::MIN_POSITIVE);
-    let (lo, hi) = (bounds.min.as_dvec3(), bounds.max.as_dvec3());
-    // The light's vertices in f64, once (on the stack for up to eight).
-    let mut stack = [DVec3::ZERO; 8];
-    let heap: Vec<DVec3>;
-    let pv: &[DVec3] = if light.len() <= stack.len() {
-        for (d, p) in stack.iter_mut().zip(light) {
-            *d = p.as_dvec3();
-        }
-        &stack[..light.len()]
-    } else {
-        heap = light.iter().map(|p| p.as_dvec3()).collect();
-        &heap
-    };
+    let (lo, hi) = (bounds.min.as_dvec3().to_array(), bounds.max.as_dvec3().to_array());
     // Plain comparisons: every value here is finite (`f64::min` would also handle NaN).
     let min = |a: f64, b: f64| if b < a { b } else { a };
     let max = |a: f64, b: f64| if b > a { b } else { a };
+    // The light's vertices in f64, once (on the stack for up to eight), and their least and
+    // greatest coordinate per axis.
+    let mut stack = [[0.0f64; 3]; 8];
+    let heap: Vec<[f64; 3]>;
+    let pv: &[[f64; 3]] = if light.len() <= stack.len() {
+        for (d, p) in stack.iter_mut().zip(light) {
+            *d = p.as_dvec3().to_array();
+        }
+        &stack[..light.len()]
+    } else {
+        heap = light.iter().map(|p| p.as_dvec3().to_array()).collect();
+        &heap
+    };
+    let (mut pmin, mut pmax) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+    for p in pv {
+        for k in 0..3 {
+            pmin[k] = min(pmin[k], p[k]);
+            pmax[k] = max(pmax[k], p[k]);
+        }
+    }
     let mut all_exit = false;
     for k in 0..3 {
         let (u, v) = ((k + 1) % 3, (k + 2) % 3);
         for positive in [false, true] {
             let w = if positive { hi[k] } else { lo[k] };
             // Signed distance beyond the face plane, away from x.
-            let beyond = |p: DVec3| if positive { p[k] - w } else { w - p[k] };
-            let (least, most) =
-                pv.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &p| (min(a, beyond(p)), max(b, beyond(p))));
+            let beyond = |c: f64| if positive { c - w } else { w - c };
+            // The least and greatest over the light's vertices (subtracting one value keeps the
+            // order of the rounded results, so these are the extremes of `beyond` per vertex).
+            let (least, most) = if positive { (beyond(pmin[k]), beyond(pmax[k])) } else { (beyond(pmax[k]), beyond(pmin[k])) };
             if most <= margin {
                 // No light point lies clearly beyond this plane: a segment may still reach it
                 // within rounding; it is counted as crossing the whole face only if some vertex
@@ -79,17 +88,17 @@ pub fn footprints(
             }
             let rect = if least > margin {
                 // Every segment crosses the plane: the cross-section is the projection of the polygon.
-                let h = beyond(xd).abs();
+                let h = beyond(xd[k]).abs();
                 let mut r = [f64::INFINITY, f64::NEG_INFINITY, f64::INFINITY, f64::NEG_INFINITY];
                 // Every segment leaves the box at the latest where it crosses this plane, at
                 // parameter s <= max over vertices (the parameter is monotone along the polygon's
                 // points, being h / (h + beyond) with beyond affine).
                 let mut s_max = 0.0f64;
-                for &p in pv {
-                    // The point of the segment x -> p on the plane.
-                    let s = h / (h + beyond(p));
-                    let q = xd + (p - xd) * s;
-                    r = [min(r[0], q[u]), max(r[1], q[u]), min(r[2], q[v]), max(r[3], q[v])];
+                for p in pv {
+                    // The point of the segment x -> p on the plane (its two coordinates in it).
+                    let s = h / (h + beyond(p[k]));
+                    let (qu, qv) = (xd[u] + (p[u] - xd[u]) * s, xd[v] + (p[v] - xd[v]) * s);
+                    r = [min(r[0], qu), max(r[1], qu), min(r[2], qv), max(r[3], qv)];
                     s_max = max(s_max, s);
                 }
                 if s_max < 1.0 - 4.0 * eps as f64 {

@@ -100,9 +100,12 @@ impl LieVisibility<'_> {
                     };
                     let (i0, i1) = (cell(fp.rect[0], u), cell(fp.rect[1], u));
                     let (j0, j1) = (cell(fp.rect[2], v), cell(fp.rect[3], v));
-                    let at = |i: usize, j: usize| self.sat[start as usize + j * (g + 1) + i];
-                    let count =
-                        |w: usize| at(i1 + 1, j1 + 1)[w] + at(i0, j0)[w] - at(i0, j1 + 1)[w] - at(i1 + 1, j0)[w];
+                    // The table's four corners of the cells `[i0, i1] x [j0, j1]`.
+                    let row = g + 1;
+                    let sat = &self.sat[start as usize..start as usize + row * row];
+                    let (first, last) = (&sat[j0 * row..(j0 + 1) * row], &sat[(j1 + 1) * row..(j1 + 2) * row]);
+                    let (a, b, c, d) = (first[i0], first[i1 + 1], last[i0], last[i1 + 1]);
+                    let count = |w: usize| d[w] + a[w] - c[w] - b[w];
                     lit &= count(0) == 0;
                     umbra &= count(1) == 0;
                     listed &= count(2) == 0;
