@@ -47,18 +47,22 @@ impl Bvh {
         ctx: &mut QueryCtx,
     ) {
         #[cfg(target_arch = "x86_64")]
-        if std::arch::is_x86_feature_detected!("avx2") {
-            // SAFETY: AVX2 is available (checked above).
+        if std::arch::is_x86_feature_detected!("avx2")
+            && std::arch::is_x86_feature_detected!("popcnt")
+            && std::arch::is_x86_feature_detected!("bmi1")
+        {
+            // SAFETY: AVX2, POPCNT and BMI1 are available (checked above).
             return unsafe { self.fan_occluded_avx(cut, scene, rays, fan, walk, out, ctx) };
         }
         self.fan_occluded_in(cut, scene, rays, fan, walk, out, ctx)
     }
 
     /// [`Bvh::fan_occluded`] compiled for AVX2 as a whole, so that the lane kernels (AVX2
-    /// functions) inline into the walk instead of being called per node and triangle. The same
+    /// functions) inline into the walk instead of being called per node and triangle, and the
+    /// masks' bit counts and scans are single instructions (POPCNT, BMI1's TZCNT). The same
     /// operations, so the same answers: Rust never fuses a multiply and an add.
     #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx,avx2")]
+    #[target_feature(enable = "avx,avx2,popcnt,bmi1")]
     #[allow(clippy::too_many_arguments)]
     unsafe fn fan_occluded_avx(
         &self,
