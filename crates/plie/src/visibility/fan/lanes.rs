@@ -30,6 +30,7 @@ pub(super) fn inverse(d: f32) -> f32 {
 /// does the rest.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx,avx2")]
+#[inline]
 pub(super) unsafe fn ray_lanes_avx(d: [&[f32]; 3], out: [&mut [f32]; 5], kz: &mut [u32]) -> usize {
     use std::arch::x86_64::*;
     let [dx, dy, dz] = d;
@@ -119,6 +120,7 @@ unsafe fn slab_avx(
 /// computes it from the direction `d`, `sz = 1 / d[kz]` and `kz`: the axes `kx = kz + 1`, `ky = kx + 1`
 /// (mod 3, swapped where `d[kz] < 0`) and `sx = d[kx] sz`, `sy = d[ky] sz`, into `s` and `k`. Eight
 /// rays at a time with AVX2 where available, each lane as the scalar code computes it.
+#[inline(always)]
 pub(super) fn shear_lanes(d: [&[f32]; 3], sz: &[f32], kz: &[u32], s: [&mut [f32]; 2], k: [&mut [u32]; 2]) {
     let n = d
         .iter()
@@ -150,6 +152,7 @@ pub(super) fn shear_lanes(d: [&[f32]; 3], sz: &[f32], kz: &[u32], s: [&mut [f32]
 /// it did.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx,avx2")]
+#[inline]
 unsafe fn shear_lanes_avx(
     d: [&[f32]; 3],
     sz: &[f32],

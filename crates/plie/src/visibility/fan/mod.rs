@@ -80,6 +80,24 @@ pub struct Fan {
 impl Fan {
     /// Starts the fan of `rays` (directions computed exactly as [`super::ShadowRay::new`] does).
     pub fn set(&mut self, rays: &LightRays) {
+        #[cfg(target_arch = "x86_64")]
+        if std::arch::is_x86_feature_detected!("avx2") {
+            // SAFETY: AVX2 is available (checked above).
+            return unsafe { self.set_avx(rays) };
+        }
+        self.set_in(rays)
+    }
+
+    /// [`Fan::set`] compiled for AVX2 as a whole, so that its lane kernels inline into it.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx,avx2")]
+    unsafe fn set_avx(&mut self, rays: &LightRays) {
+        self.set_in(rays)
+    }
+
+    /// The body of [`Fan::set`].
+    #[inline(always)]
+    fn set_in(&mut self, rays: &LightRays) {
         let x = rays.origin;
         let n = rays.targets.len();
         self.origin = x;
