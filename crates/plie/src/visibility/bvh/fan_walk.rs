@@ -90,15 +90,19 @@ impl Bvh {
         out: &mut [bool],
         ctx: &mut QueryCtx,
     ) {
-        match &self.groups {
-            None => self.fan_walk(cut, &Single, scene, rays, fan, walk, out, ctx),
-            Some(g) => self.fan_walk(cut, g, scene, rays, fan, walk, out, ctx),
+        // Up to 64 rays (one word of mask, the usual case) with the word count known to the
+        // compiler.
+        match (&self.groups, fan.words() == 1) {
+            (None, true) => self.fan_walk::<_, true>(cut, &Single, scene, rays, fan, walk, out, ctx),
+            (None, false) => self.fan_walk::<_, false>(cut, &Single, scene, rays, fan, walk, out, ctx),
+            (Some(g), true) => self.fan_walk::<_, true>(cut, g, scene, rays, fan, walk, out, ctx),
+            (Some(g), false) => self.fan_walk::<_, false>(cut, g, scene, rays, fan, walk, out, ctx),
         }
     }
 
     #[allow(clippy::too_many_arguments)]
     #[inline(always)]
-    fn fan_walk<P: Prims>(
+    fn fan_walk<P: Prims, const ONE: bool>(
         &self,
         cut: Option<&Cut>,
         prims: &P,
@@ -109,7 +113,7 @@ impl Bvh {
         out: &mut [bool],
         ctx: &mut QueryCtx,
     ) {
-        let w = fan.words();
+        let w = if ONE { 1 } else { fan.words() };
         if self.cw.nodes.is_empty() || fan.live() == 0 {
             return;
         }
@@ -142,9 +146,9 @@ impl Bvh {
                     let filled = ((1u16 << n) - 1) as u8;
                     node_mask.clear();
                     node_mask.extend_from_slice(fan.open());
-                    let hit = fan.meets8(&los, &his, filled & !culled, node_mask, child_masks, ctx);
+                    let hit = fan.meets8(&los, &his, filled & !culled, &node_mask[..w], &mut child_masks[..8 * w], ctx);
                     let at = (hit, &los, &his, |c: usize| cut.child[first + c]);
-                    if self.take_children(prims, scene, rays, fan, out, ctx, at, toward, nodes, masks, child_masks) {
+                    if self.take_children::<P, ONE>(prims, scene, rays, fan, out, ctx, at, toward, nodes, masks, child_masks) {
                         return;
                     }
                 }
@@ -178,9 +182,9 @@ impl Bvh {
             }
             let culled = fan.pyramid.culls_rel8(&los, &his);
             let filled = nonzero_bytes(node.child_meta);
-            let hit = fan.meets8(&los, &his, filled & !culled, node_mask, child_masks, ctx);
+            let hit = fan.meets8(&los, &his, filled & !culled, &node_mask[..w], &mut child_masks[..8 * w], ctx);
             let at = (hit, &los, &his, |c: usize| Child::of(node, c));
-            if self.take_children(prims, scene, rays, fan, out, ctx, at, toward, nodes, masks, child_masks) {
+            if self.take_children::<P, ONE>(prims, scene, rays, fan, out, ctx, at, toward, nodes, masks, child_masks) {
                 return;
             }
         }
@@ -191,7 +195,7 @@ impl Bvh {
     /// rays, inner nodes pushed nearest first. True once every ray is closed.
     #[allow(clippy::too_many_arguments)]
     #[inline(always)]
-    fn take_children<P: Prims>(
+    fn take_children<P: Prims, const ONE: bool>(
         &self,
         prims: &P,
         scene: &Scene,
@@ -205,7 +209,7 @@ impl Bvh {
         masks: &mut Vec<u64>,
         child_masks: &[u64],
     ) -> bool {
-        let w = fan.words();
+        let w = if ONE { 1 } else { fan.words() };
         let mut pending = [(0f32, 0u32, 0usize); 8];
         let mut count = 0;
         for child in (0..8).filter(|c| hit >> c & 1 != 0) {

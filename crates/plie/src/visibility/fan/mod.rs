@@ -281,7 +281,9 @@ impl Fan {
     ) -> u8 {
         let [.., ix, iy, iz] = &self.all;
         let lanes = BoxLanes { ix, iy, iz };
-        let w = self.open.len();
+        // The caller's slices say how many words (so a caller that knows it lets the compiler know).
+        let w = within.len();
+        debug_assert_eq!(w, self.open.len());
         let mut hit = 0u8;
         let mut out = [0u64; 8];
         for i in 0..w {
@@ -350,12 +352,16 @@ impl Fan {
     ) {
         let tri = &scene.triangles[t.idx()];
         let mask = |w: usize| within.map_or(u64::MAX, |m| m[w]);
+        // The words of the mask (from `within` where given, so a caller that knows it lets the
+        // compiler know).
+        let words = within.map_or(self.open.len(), |m| m.len());
+        debug_assert_eq!(words, self.open.len());
         let count = match within {
             None => self.live as u32,
-            Some(_) => (0..self.open.len()).map(|w| (self.open[w] & mask(w)).count_ones()).sum(),
+            Some(_) => (0..words).map(|w| (self.open[w] & mask(w)).count_ones()).sum(),
         };
         if count <= DIRECT_MAX {
-            for w in 0..self.open.len() {
+            for w in 0..words {
                 let bits = self.open[w] & mask(w);
                 self.exact(tri, w, bits, rays, out, ctx);
             }
@@ -387,7 +393,7 @@ impl Fan {
         } else {
             self.maybe.fill(u64::MAX);
         }
-        for w in 0..self.open.len() {
+        for w in 0..words {
             let bits = self.maybe[w] & self.open[w] & mask(w);
             self.exact(tri, w, bits, rays, out, ctx);
         }
