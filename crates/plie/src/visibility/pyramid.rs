@@ -42,8 +42,12 @@ impl Pyramid {
         // The sample domain's hull is the polygon (plus, for a parallelogram, its fourth corner
         // recomputed, within rounding of the vertex): the polygon's edges, grown by the margin.
         let toward_centre = light.center() - x;
+        // Each edge (v[i], v[i + 1]), the last closing the polygon, relative to the apex.
+        let mut q = v[0] - x;
+        let first = q;
         for i in 0..v.len() {
-            let (p, q) = (v[i] - x, v[(i + 1) % v.len()] - x);
+            let p = q;
+            q = if i + 1 < v.len() { v[i + 1] - x } else { first };
             // The plane through the apex and the edge (p, q), its normal turned toward the centre.
             let s = p.cross(q);
             let len = s.length();

@@ -26,7 +26,7 @@ use super::crowd::{Prims, Single};
 use super::cut::{Child, Cut};
 use super::Bvh;
 use crate::scene::{Scene, TriId};
-use crate::visibility::fan::{Fan, WalkStack};
+use crate::visibility::fan::{nonzero_bytes, Fan, WalkStack};
 use crate::visibility::{LightRays, QueryCtx};
 
 impl Bvh {
@@ -50,8 +50,9 @@ impl Bvh {
         if std::arch::is_x86_feature_detected!("avx2")
             && std::arch::is_x86_feature_detected!("popcnt")
             && std::arch::is_x86_feature_detected!("bmi1")
+            && std::arch::is_x86_feature_detected!("lzcnt")
         {
-            // SAFETY: AVX2, POPCNT and BMI1 are available (checked above).
+            // SAFETY: AVX2, POPCNT, BMI1 and LZCNT are available (checked above).
             return unsafe { self.fan_occluded_avx(cut, scene, rays, fan, walk, out, ctx) };
         }
         self.fan_occluded_in(cut, scene, rays, fan, walk, out, ctx)
@@ -59,10 +60,10 @@ impl Bvh {
 
     /// [`Bvh::fan_occluded`] compiled for AVX2 as a whole, so that the lane kernels (AVX2
     /// functions) inline into the walk instead of being called per node and triangle, and the
-    /// masks' bit counts and scans are single instructions (POPCNT, BMI1's TZCNT). The same
+    /// masks' bit counts and scans are single instructions (POPCNT, TZCNT, LZCNT). The same
     /// operations, so the same answers: Rust never fuses a multiply and an add.
     #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx,avx2,popcnt,bmi1")]
+    #[target_feature(enable = "avx,avx2,popcnt,bmi1,lzcnt")]
     #[allow(clippy::too_many_arguments)]
     unsafe fn fan_occluded_avx(
         &self,
@@ -181,7 +182,7 @@ impl Bvh {
                 }
             }
             let culled = fan.pyramid.culls_rel8(&los, &his);
-            let filled = nonzero_bytes(node.child_meta);
+            let filled = nonzero_bytes(u64::from_le_bytes(node.child_meta));
             let hit = fan.meets8(&los, &his, filled & !culled, &node_mask[..w], &mut child_masks[..8 * w], ctx);
             let at = (hit, &los, &his, |c: usize| Child::of(node, c));
             if self.take_children::<P, ONE>(prims, scene, rays, fan, out, ctx, at, toward, nodes, masks, child_masks) {
@@ -256,17 +257,6 @@ impl Bvh {
     }
 }
 
-/// Bit `c` set where byte `c` of `bytes` is not zero.
-#[inline(always)]
-fn nonzero_bytes(bytes: [u8; 8]) -> u8 {
-    let m = u64::from_le_bytes(bytes);
-    const LOW7: u64 = 0x7f7f_7f7f_7f7f_7f7f;
-    // The top bit of each byte: set where the byte is not zero.
-    let top = (((m & LOW7) + LOW7) | m) & !LOW7;
-    // Gathers the eight top bits into the top byte.
-    ((top >> 7).wrapping_mul(0x0102_0408_1020_4080) >> 56) as u8
-}
-
 #[cfg(test)]
 mod tests {
     use super::nonzero_bytes;
@@ -279,7 +269,7 @@ mod tests {
                 let bytes: [u8; 8] =
                     std::array::from_fn(|c| if pattern >> c & 1 != 0 { value.rotate_left(c as u32) } else { 0 });
                 let want = bytes.iter().enumerate().fold(0u8, |b, (c, &m)| b | u8::from(m != 0) << c);
-                assert_eq!(nonzero_bytes(bytes), want, "{bytes:?}");
+                assert_eq!(nonzero_bytes(u64::from_le_bytes(bytes)), want, "{bytes:?}");
             }
         }
     }

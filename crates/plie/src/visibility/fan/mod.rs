@@ -29,6 +29,7 @@ use crate::geometry::{RayTest, Triangle};
 use crate::scene::{Scene, TriId};
 
 pub use super::pyramid::Pyramid;
+pub(crate) use lanes::nonzero_bytes;
 
 mod lanes;
 
