@@ -176,8 +176,9 @@ impl LieVisibility<'_> {
 /// Most triangles, in all, of the distinct lists a light's footprints gather ([`Whole::Lists`]); a
 /// light over more is answered by the scene BVH. Measured (callgrind of the query at 64 rays on
 /// cornell-cube-2, huis-c, dragon, cornell-bunny and conference-lit, docs/results.md session 8): 32
-/// needed the fewest instructions in all of 16, 32, 64, 256 and 1024.
-pub(super) const GATHER_MAX: usize = 32;
+/// needed the fewest instructions in all of 16, 32, 64, 256 and 1024. Once the walk got cheaper
+/// (session 13), 16 needed 1.3% fewer than 32 over eight scenes and ray counts.
+pub(super) const GATHER_MAX: usize = 16;
 
 /// A blocker list key of a per-light query: a record's index, or a face-grid cell's index with the
 /// top bit set.
