@@ -73,7 +73,8 @@ pub fn footprints(
             let beyond = |c: f64| if positive { c - w } else { w - c };
             // The least and greatest over the light's vertices (subtracting one value keeps the
             // order of the rounded results, so these are the extremes of `beyond` per vertex).
-            let (least, most) = if positive { (beyond(pmin[k]), beyond(pmax[k])) } else { (beyond(pmax[k]), beyond(pmin[k])) };
+            let (least, most) =
+                if positive { (beyond(pmin[k]), beyond(pmax[k])) } else { (beyond(pmax[k]), beyond(pmin[k])) };
             if most <= margin {
                 // No light point lies clearly beyond this plane: a segment may still reach it
                 // within rounding; it is counted as crossing the whole face only if some vertex

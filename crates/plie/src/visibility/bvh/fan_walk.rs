@@ -149,7 +149,19 @@ impl Bvh {
                     node_mask.extend_from_slice(fan.open());
                     let hit = fan.meets8(&los, &his, filled & !culled, &node_mask[..w], &mut child_masks[..8 * w], ctx);
                     let at = (hit, &los, &his, |c: usize| cut.child[first + c]);
-                    if self.take_children::<P, ONE>(prims, scene, rays, fan, out, ctx, at, toward, nodes, masks, child_masks) {
+                    if self.take_children::<P, ONE>(
+                        prims,
+                        scene,
+                        rays,
+                        fan,
+                        out,
+                        ctx,
+                        at,
+                        toward,
+                        nodes,
+                        masks,
+                        child_masks,
+                    ) {
                         return;
                     }
                 }
