@@ -18,7 +18,9 @@
 //! every answer is [`super::segment_occluded`]'s, which is brute force's.
 //!
 //! Where the CPU has AVX2, the walk is compiled for it as a whole, so that the fan's lane kernels
-//! inline into it (measured: 4-8% fewer instructions per query, docs/results.md session 13).
+//! inline into it (measured: 2-8% fewer instructions per query, docs/results.md session 13), and a
+//! fan of at most 64 rays (one word of mask) has its own copy in which the loops over mask words
+//! collapse.
 
 use glam::{Vec3, Vec3A};
 
