@@ -52,9 +52,8 @@ impl Bvh {
         if std::arch::is_x86_feature_detected!("avx2")
             && std::arch::is_x86_feature_detected!("popcnt")
             && std::arch::is_x86_feature_detected!("bmi1")
-            && std::arch::is_x86_feature_detected!("lzcnt")
         {
-            // SAFETY: AVX2, POPCNT, BMI1 and LZCNT are available (checked above).
+            // SAFETY: AVX2, POPCNT and BMI1 are available (checked above).
             return unsafe { self.fan_occluded_avx(cut, scene, rays, fan, walk, out, ctx) };
         }
         self.fan_occluded_in(cut, scene, rays, fan, walk, out, ctx)
@@ -62,10 +61,10 @@ impl Bvh {
 
     /// [`Bvh::fan_occluded`] compiled for AVX2 as a whole, so that the lane kernels (AVX2
     /// functions) inline into the walk instead of being called per node and triangle, and the
-    /// masks' bit counts and scans are single instructions (POPCNT, TZCNT, LZCNT). The same
+    /// masks' bit counts and scans are single instructions (POPCNT, BMI1's TZCNT). The same
     /// operations, so the same answers: Rust never fuses a multiply and an add.
     #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx,avx2,popcnt,bmi1,lzcnt")]
+    #[target_feature(enable = "avx,avx2,popcnt,bmi1")]
     #[allow(clippy::too_many_arguments)]
     unsafe fn fan_occluded_avx(
         &self,
@@ -268,23 +267,5 @@ impl Bvh {
             }
         }
         false
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::nonzero_bytes;
-
-    /// The nonzero-byte mask of every pattern of zero and nonzero bytes (with several nonzero values).
-    #[test]
-    fn nonzero_bytes_marks_every_nonzero_byte() {
-        for pattern in 0..=255u8 {
-            for value in [1u8, 0x7f, 0x80, 0xff, 0x24] {
-                let bytes: [u8; 8] =
-                    std::array::from_fn(|c| if pattern >> c & 1 != 0 { value.rotate_left(c as u32) } else { 0 });
-                let want = bytes.iter().enumerate().fold(0u8, |b, (c, &m)| b | u8::from(m != 0) << c);
-                assert_eq!(nonzero_bytes(u64::from_le_bytes(bytes)), want, "{bytes:?}");
-            }
-        }
     }
 }

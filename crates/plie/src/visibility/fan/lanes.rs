@@ -580,6 +580,19 @@ mod tests {
         }
     }
 
+    /// The nonzero-byte mask of every pattern of zero and nonzero bytes (with several nonzero values).
+    #[test]
+    fn nonzero_bytes_marks_every_nonzero_byte() {
+        for pattern in 0..=255u8 {
+            for value in [1u8, 0x7f, 0x80, 0xff, 0x24] {
+                let bytes: [u8; 8] =
+                    std::array::from_fn(|c| if pattern >> c & 1 != 0 { value.rotate_left(c as u32) } else { 0 });
+                let want = bytes.iter().enumerate().fold(0u8, |b, (c, &m)| b | u8::from(m != 0) << c);
+                assert_eq!(nonzero_bytes(u64::from_le_bytes(bytes)), want, "{bytes:?}");
+            }
+        }
+    }
+
     /// The eight-lane ray values are the scalar loop's, bit for bit, on ordinary, tied, zero, signed
     /// zero, tiny and huge components.
     #[test]
