@@ -122,6 +122,24 @@ fn per_light_answers_with_grids_and_a_small_blocker_cap() {
     }
 }
 
+/// With 8 to 16 samples (which go straight to the watertight test, without the lane test), the
+/// lights answered through the gathered lists are counted as gathered, not as whole lit.
+#[test]
+fn gathered_lights_are_counted_with_few_samples() {
+    let scene = plie::scene::builtin::load("huis-c").unwrap();
+    let built = Built::new(&scene, PlieParams::default());
+    let qs: Vec<Query> = queries(&scene, &built, 400, 25)
+        .into_iter()
+        .filter(|q| q.targets.len() >= 8)
+        .map(|mut q| {
+            q.targets.truncate(16);
+            q
+        })
+        .collect();
+    let l = check(&scene, &built, &qs).lights;
+    assert!(l.gathered > 0 && l.whole_lit > 0, "{l:?}");
+}
+
 /// The refined P-LIE (split leaves) answers per light as per ray too.
 #[test]
 fn per_light_answers_on_a_refined_p_lie() {

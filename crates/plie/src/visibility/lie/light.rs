@@ -23,7 +23,8 @@ impl LieVisibility<'_> {
     /// as a fan culled by the pyramid.
     fn lists_only(&self, leaf: LeafId, rays: &LightRays, sc: &mut LightScratch, out: &mut [bool], ctx: &mut QueryCtx) {
         out.fill(false);
-        let lanes_before = ctx.stats.lane_tests;
+        // Tests in lanes or by the watertight test (which up to `DIRECT_MAX` rays go to directly).
+        let tests_before = ctx.stats.lane_tests + ctx.stats.triangle_tests;
         sc.fan.set(rays);
         sc.fan.pyramid.set_in(self.scene, rays.origin, rays.light);
         ctx.begin_query();
@@ -45,7 +46,7 @@ impl LieVisibility<'_> {
         answers.count_n(Answer::BlockersHit, list_hits);
         answers.count_n(Answer::OwnLeaf, hits - list_hits);
         answers.count_n(Answer::BlockersMiss, out.len() - hits);
-        if ctx.stats.lane_tests == lanes_before {
+        if ctx.stats.lane_tests + ctx.stats.triangle_tests == tests_before {
             ctx.stats.lights.whole_lit += 1;
         } else {
             ctx.stats.lights.gathered += 1;
@@ -127,7 +128,8 @@ impl LieVisibility<'_> {
         let (start, len) = self.own[leaf.idx()];
         let own = self.own_boxes.of(leaf.idx(), &self.own_tris[start as usize..(start + len) as usize]);
         let before = ctx.stats.triangle_tests;
-        let lanes_before = ctx.stats.lane_tests;
+        // Tests in lanes or by the watertight test (which up to `DIRECT_MAX` rays go to directly).
+        let tests_before = ctx.stats.lane_tests + ctx.stats.triangle_tests;
         if self.any_in_pyramid(rays, own, &sc.fan.pyramid, ctx) {
             sc.fan.set(rays);
             self.fan_list(rays, own, false, &mut sc.fan, out, ctx);
@@ -136,7 +138,7 @@ impl LieVisibility<'_> {
         let hits = out.iter().filter(|&&o| o).count();
         ctx.stats.answers.count_n(Answer::OwnLeaf, hits);
         ctx.stats.answers.count_n(Answer::Lit, out.len() - hits);
-        if ctx.stats.lane_tests == lanes_before {
+        if ctx.stats.lane_tests + ctx.stats.triangle_tests == tests_before {
             ctx.stats.lights.whole_lit += 1;
         } else {
             ctx.stats.lights.gathered += 1;
