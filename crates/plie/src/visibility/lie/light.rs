@@ -177,7 +177,7 @@ impl LieVisibility<'_> {
 
     /// Tests the triangles `tris` that the pyramid does not cull against the fan's open rays,
     /// marking those hit in `out`; with `once`, only those not met before in the query.
-    #[inline]
+    #[inline(always)]
     fn fan_tris(
         &self,
         rays: &LightRays,
@@ -206,8 +206,46 @@ impl LieVisibility<'_> {
     }
 
     /// [`Self::fan_tris`] over a blocker list, skipping the boxes of its hierarchy that the
-    /// pyramid culls.
+    /// pyramid culls. Where the CPU has AVX2, as one copy compiled for it (as the scene BVH's walk
+    /// is), so that the fan's lane kernels inline into it.
     fn fan_list(
+        &self,
+        rays: &LightRays,
+        list: Chunked,
+        once: bool,
+        fan: &mut Fan,
+        out: &mut [bool],
+        ctx: &mut QueryCtx,
+    ) {
+        #[cfg(target_arch = "x86_64")]
+        if std::arch::is_x86_feature_detected!("avx2")
+            && std::arch::is_x86_feature_detected!("popcnt")
+            && std::arch::is_x86_feature_detected!("bmi1")
+        {
+            // SAFETY: AVX2, POPCNT and BMI1 are available (checked above).
+            return unsafe { self.fan_list_avx(rays, list, once, fan, out, ctx) };
+        }
+        self.fan_list_in(rays, list, once, fan, out, ctx)
+    }
+
+    /// [`Self::fan_list`] compiled for AVX2: the same operations, so the same answers.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx,avx2,popcnt,bmi1")]
+    unsafe fn fan_list_avx(
+        &self,
+        rays: &LightRays,
+        list: Chunked,
+        once: bool,
+        fan: &mut Fan,
+        out: &mut [bool],
+        ctx: &mut QueryCtx,
+    ) {
+        self.fan_list_in(rays, list, once, fan, out, ctx)
+    }
+
+    /// The body of [`Self::fan_list`].
+    #[inline(always)]
+    fn fan_list_in(
         &self,
         rays: &LightRays,
         list: Chunked,
@@ -226,12 +264,12 @@ impl LieVisibility<'_> {
             ctx: &'c mut QueryCtx,
         }
         impl ListVisitor for Tris<'_, '_, '_> {
-            #[inline]
+            #[inline(always)]
             fn enter(&mut self, b: &Aabb, _: usize) -> bool {
                 self.ctx.stats.box_tests += 1;
                 self.fan.live() > 0 && !self.fan.pyramid.culls_box(b)
             }
-            #[inline]
+            #[inline(always)]
             fn chunk(&mut self, tris: &[TriId], _: usize) -> bool {
                 self.vis.fan_tris(self.rays, tris, self.once, self.fan, self.out, self.ctx);
                 self.fan.live() == 0
