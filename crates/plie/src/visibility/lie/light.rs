@@ -23,8 +23,7 @@ impl LieVisibility<'_> {
     /// as a fan culled by the pyramid.
     fn lists_only(&self, leaf: LeafId, rays: &LightRays, sc: &mut LightScratch, out: &mut [bool], ctx: &mut QueryCtx) {
         out.fill(false);
-        // Tests in lanes or by the watertight test (which up to `DIRECT_MAX` rays go to directly).
-        let tests_before = ctx.stats.lane_tests + ctx.stats.triangle_tests;
+        let tests_before = fan_tests(ctx);
         sc.fan.set(rays);
         sc.fan.pyramid.set_in(self.scene, rays.origin, rays.light);
         ctx.begin_query();
@@ -46,11 +45,7 @@ impl LieVisibility<'_> {
         answers.count_n(Answer::BlockersHit, list_hits);
         answers.count_n(Answer::OwnLeaf, hits - list_hits);
         answers.count_n(Answer::BlockersMiss, out.len() - hits);
-        if ctx.stats.lane_tests + ctx.stats.triangle_tests == tests_before {
-            ctx.stats.lights.whole_lit += 1;
-        } else {
-            ctx.stats.lights.gathered += 1;
-        }
+        count_lit_or_gathered(ctx, tests_before);
     }
 
     /// All samples of one light from one point (issue 21), by the footprints' verdict
@@ -128,8 +123,7 @@ impl LieVisibility<'_> {
         let (start, len) = self.own[leaf.idx()];
         let own = self.own_boxes.of(leaf.idx(), &self.own_tris[start as usize..(start + len) as usize]);
         let before = ctx.stats.triangle_tests;
-        // Tests in lanes or by the watertight test (which up to `DIRECT_MAX` rays go to directly).
-        let tests_before = ctx.stats.lane_tests + ctx.stats.triangle_tests;
+        let tests_before = fan_tests(ctx);
         if self.any_in_pyramid(rays, own, &sc.fan.pyramid, ctx) {
             sc.fan.set(rays);
             self.fan_list(rays, own, false, &mut sc.fan, out, ctx);
@@ -138,11 +132,7 @@ impl LieVisibility<'_> {
         let hits = out.iter().filter(|&&o| o).count();
         ctx.stats.answers.count_n(Answer::OwnLeaf, hits);
         ctx.stats.answers.count_n(Answer::Lit, out.len() - hits);
-        if ctx.stats.lane_tests + ctx.stats.triangle_tests == tests_before {
-            ctx.stats.lights.whole_lit += 1;
-        } else {
-            ctx.stats.lights.gathered += 1;
-        }
+        count_lit_or_gathered(ctx, tests_before);
     }
 
     /// True if a triangle of `list` (other than the rays' own) is not culled by `pyramid`.
@@ -278,6 +268,22 @@ impl LieVisibility<'_> {
         if fan.live() > 0 {
             list.walk(&mut Tris { vis: self, rays, once, fan, out, ctx });
         }
+    }
+}
+
+/// The fan's tests run so far: in lanes, or by the watertight test (to which up to `DIRECT_MAX`
+/// rays go directly).
+fn fan_tests(ctx: &QueryCtx) -> u64 {
+    ctx.stats.lane_tests + ctx.stats.triangle_tests
+}
+
+/// Counts a light answered without the scene BVH: whole lit if its fan ran no test since
+/// `tests_before` ([`fan_tests`]), else gathered.
+fn count_lit_or_gathered(ctx: &mut QueryCtx, tests_before: u64) {
+    if fan_tests(ctx) == tests_before {
+        ctx.stats.lights.whole_lit += 1;
+    } else {
+        ctx.stats.lights.gathered += 1;
     }
 }
 
