@@ -162,7 +162,6 @@ fn cosine_sample(n: Vec3, u: Vec2) -> (Vec3, f32) {
 struct Scratch {
     ctx: QueryCtx,
     samples: Vec<Vec2>,
-    perm: Vec<u32>,
     targets: Vec<Vec3>,
     weights: Vec<f32>,
     occluded: Vec<bool>,
@@ -206,7 +205,7 @@ impl Tracer<'_> {
             }
             let p_select = self.select[i];
             let mut rng = Rng::stream(self.seed, pixel, sample, key(bounce, Purpose::Light, i as u32));
-            n_rooks(&mut rng, &mut s.samples, &mut s.perm);
+            n_rooks(&mut rng, &mut s.samples);
             s.targets.clear();
             s.weights.clear();
             for &u in &s.samples {
@@ -380,7 +379,6 @@ pub fn render_path(
             || Scratch {
                 ctx: QueryCtx::new(scene.triangles.len()),
                 samples: vec![Vec2::ZERO; n],
-                perm: Vec::with_capacity(n),
                 targets: Vec::with_capacity(n),
                 weights: Vec::with_capacity(n),
                 occluded: vec![false; n],

@@ -23,7 +23,6 @@ pub struct ShadeScratch {
     /// Visibility query context.
     pub ctx: QueryCtx,
     samples: Vec<Vec2>,
-    perm: Vec<u32>,
     /// The current light's sample points, and per sample its geometry term (`NaN`: it does not
     /// face the point).
     points: Vec<Vec3>,
@@ -41,7 +40,6 @@ impl ShadeScratch {
         ShadeScratch {
             ctx: QueryCtx::new(scene.triangles.len()),
             samples: vec![Vec2::ZERO; n],
-            perm: Vec::with_capacity(n),
             points: Vec::with_capacity(n),
             terms: Vec::with_capacity(n),
             targets: Vec::with_capacity(n),
@@ -53,18 +51,18 @@ impl ShadeScratch {
 
 /// The geometry term `cos_x cos_y / |x - y|^2` of each sample point `y` of a light with normal
 /// `nl`, seen from `x` with normal `n`, into `terms`; `NaN` where either cosine is not positive
-/// (or `y = x`): no shadow ray is shot there. Written lane by lane so that it vectorises; `sqrt` and
-/// division are correctly rounded in every lane, so the values are those of the scalar formula.
+/// (or `y = x`): no shadow ray is shot there. Written lane by lane so that it vectorises; division
+/// is correctly rounded in every lane, so the values are those of the scalar formula.
 fn geometry_terms(x: Vec3, n: Vec3, nl: Vec3, points: &[Vec3], terms: &mut Vec<f32>) {
     terms.clear();
     terms.extend(points.iter().map(|&y| {
         let d = y - x;
         let dist2 = d.length_squared();
-        let inv_len = dist2.sqrt().recip();
-        let cos_x = n.dot(d) * inv_len;
-        let cos_y = -nl.dot(d) * inv_len;
-        if dist2 > 0.0 && cos_x > 0.0 && cos_y > 0.0 {
-            cos_x * cos_y / dist2
+        // cos_x cos_y / |d|^2 = (n.d / |d|^2) (-nl.d / |d|^2), without a square root.
+        let inv = dist2.recip();
+        let (a, b) = (n.dot(d), -nl.dot(d));
+        if dist2 > 0.0 && a > 0.0 && b > 0.0 {
+            a * inv * (b * inv)
         } else {
             f32::NAN
         }
@@ -109,27 +107,32 @@ pub fn shade_hit(
     let n_samples = s.samples.len();
     for (i, light) in scene.lights.iter().enumerate() {
         let mut rng = Rng::stream(seed, stream.0, stream.1, i as u64);
-        n_rooks(&mut rng, &mut s.samples, &mut s.perm);
+        n_rooks(&mut rng, &mut s.samples);
         s.points.clear();
         light.sample_into(&s.samples, &mut s.points);
         geometry_terms(x, hit.normal, light.normal, &s.points, &mut s.terms);
-        s.targets.clear();
-        s.weights.clear();
-        for (&y, &w) in s.points.iter().zip(&s.terms) {
-            if !w.is_nan() {
-                s.targets.push(y);
-                s.weights.push(w);
-            }
-        }
-        let m = s.targets.len();
-        if m == 0 {
+        // Usually every sample faces the point, and the points are the targets as they are.
+        let facing = s.terms.iter().filter(|w| !w.is_nan()).count();
+        if facing == 0 {
             continue;
         }
-        let rays =
-            LightRays { origin: x, origin_tri: hit.tri, leaf: hit.leaf, light: LightId(i as u32), targets: &s.targets };
-        let occluded = &mut s.occluded[..m];
+        let (targets, weights) = if facing == s.terms.len() {
+            (&s.points[..], &s.terms[..])
+        } else {
+            s.targets.clear();
+            s.weights.clear();
+            for (&y, &w) in s.points.iter().zip(&s.terms) {
+                if !w.is_nan() {
+                    s.targets.push(y);
+                    s.weights.push(w);
+                }
+            }
+            (&s.targets[..], &s.weights[..])
+        };
+        let rays = LightRays { origin: x, origin_tri: hit.tri, leaf: hit.leaf, light: LightId(i as u32), targets };
+        let occluded = &mut s.occluded[..facing];
         vis.occluded_light(&rays, occluded, &mut s.ctx);
-        let sum = unoccluded_sum(&s.weights, occluded, &mut s.ctx.stats);
+        let sum = unoccluded_sum(weights, occluded, &mut s.ctx.stats);
         l += light.radiance * f_r * (light.area / n_samples as f32 * sum);
     }
     l
