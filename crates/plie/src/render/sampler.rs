@@ -12,6 +12,9 @@ pub fn mix64(mut z: u64) -> u64 {
     z ^ (z >> 31)
 }
 
+/// splitmix64's increment: the `k`-th draw of a stream is `mix64(state + k * GOLDEN)`.
+const GOLDEN: u64 = 0x9e37_79b9_7f4a_7c15;
+
 /// A small counter-based generator (splitmix64).
 #[derive(Clone, Copy, Debug)]
 pub struct Rng(u64);
@@ -25,7 +28,7 @@ impl Rng {
     /// Next 64 random bits.
     #[inline]
     pub fn next_u64(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
+        self.0 = self.0.wrapping_add(GOLDEN);
         mix64(self.0)
     }
 
@@ -48,7 +51,67 @@ impl Rng {
 /// One 64-bit draw per point gives both jitters (24 bits each) and, for up to [`SHORT_SHUFFLE`]
 /// points, the shuffle's index (the low 16 bits). The rows are shuffled inside-out (Durstenfeld's
 /// forward form): point `i` takes the row of a random earlier point `j <= i`, which takes row `i`.
+/// The draws are counter-based, so up to [`SHORT_SHUFFLE`] points they are made for all points at
+/// once ([`draw_points`], in lanes), and the shuffle follows.
 pub fn n_rooks(rng: &mut Rng, out: &mut [Vec2]) {
+    let n = out.len();
+    if n > SHORT_SHUFFLE {
+        return n_rooks_long(rng, out);
+    }
+    let mut picks = [0u8; SHORT_SHUFFLE];
+    let picks = &mut picks[..n];
+    draw_points(rng.0, out, picks);
+    rng.0 = rng.0.wrapping_add(GOLDEN.wrapping_mul(n as u64));
+    for (i, &j) in picks.iter().enumerate() {
+        let j = usize::from(j);
+        let row = out[i].y;
+        out[i].y = out[j].y;
+        out[j].y = row;
+    }
+}
+
+/// For each point `i` of `out`, from the stream's `i + 1`-th draw after `state`: its column
+/// (jittered) in `x`, row `i` (jittered) in `y`, and in `picks` the earlier point `j <= i` whose row
+/// it takes in the shuffle. Where the CPU has AVX2, as a copy compiled for it, which computes the
+/// draws in lanes: integer arithmetic and the same rounded float operations, so the same points.
+fn draw_points(state: u64, out: &mut [Vec2], picks: &mut [u8]) {
+    #[cfg(target_arch = "x86_64")]
+    if std::arch::is_x86_feature_detected!("avx2") {
+        // SAFETY: AVX2 is available (checked above).
+        return unsafe { draw_points_avx(state, out, picks) };
+    }
+    draw_points_in(state, out, picks)
+}
+
+/// [`draw_points`] compiled for AVX2.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx,avx2")]
+unsafe fn draw_points_avx(state: u64, out: &mut [Vec2], picks: &mut [u8]) {
+    draw_points_in(state, out, picks)
+}
+
+/// The body of [`draw_points`] (at most [`SHORT_SHUFFLE`] points).
+#[inline(always)]
+fn draw_points_in(state: u64, out: &mut [Vec2], picks: &mut [u8]) {
+    let inv = 1.0 / out.len() as f32;
+    let scale = 1.0 / (1u32 << 24) as f32;
+    let mut counter = state;
+    for (i, (p, pick)) in out.iter_mut().zip(picks.iter_mut()).enumerate() {
+        let k = i as u64 + 1;
+        counter = counter.wrapping_add(GOLDEN);
+        let u = mix64(counter);
+        let fi = (i as i32) as f32;
+        let jx = ((u >> 40) as i32) as f32 * scale;
+        let jy = (((u >> 16) & 0xff_ffff) as i32) as f32 * scale;
+        // At most 1: `1 / n` may round up.
+        p.x = ((fi + jx) * inv).min(1.0);
+        p.y = ((fi + jy) * inv).min(1.0);
+        *pick = (((u & 0xffff) * k) >> 16) as u8;
+    }
+}
+
+/// [`n_rooks`] beyond [`SHORT_SHUFFLE`] points: the shuffle's index from a draw of its own.
+fn n_rooks_long(rng: &mut Rng, out: &mut [Vec2]) {
     let n = out.len();
     let inv = 1.0 / n as f32;
     let scale = 1.0 / (1u32 << 24) as f32;
@@ -56,11 +119,7 @@ pub fn n_rooks(rng: &mut Rng, out: &mut [Vec2]) {
         let u = rng.next_u64();
         let jx = (u >> 40) as f32 * scale;
         let jy = ((u >> 16) & 0xff_ffff) as f32 * scale;
-        let j = if n <= SHORT_SHUFFLE {
-            (((u & 0xffff) * (i as u64 + 1)) >> 16) as usize
-        } else {
-            rng.below(i as u32 + 1) as usize
-        };
+        let j = rng.below(i as u32 + 1) as usize;
         let row = ((i as f32 + jy) * inv).min(1.0);
         out[i].x = ((i as f32 + jx) * inv).min(1.0);
         out[i].y = out[j].y;
@@ -69,7 +128,7 @@ pub fn n_rooks(rng: &mut Rng, out: &mut [Vec2]) {
 }
 
 /// The most points whose shuffle takes its index from the jitters' draw: 16 bits pick among at
-/// most 256 rows, each with a probability within 0.4% of the others'.
+/// most 256 rows, each with a probability within 0.4% of the others', and the index fits a byte.
 pub const SHORT_SHUFFLE: usize = 256;
 
 #[cfg(test)]

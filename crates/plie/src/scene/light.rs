@@ -88,12 +88,17 @@ impl Light {
         Ok(Light { vertices, normal, area, radiance, triangles, fan_cdf, parallelogram })
     }
 
+    /// For a parallelogram, its corner `v0` and edge vectors `v1 - v0`, `v3 - v0`: [`Light::sample`]
+    /// maps `u` to `v0 + (v1 - v0) u.x + (v3 - v0) u.y`. `None` for other polygons.
+    pub fn parallelogram_edges(&self) -> Option<(Vec3, Vec3, Vec3)> {
+        let v = &self.vertices;
+        self.parallelogram.then(|| (v[0], v[1] - v[0], v[3] - v[0]))
+    }
+
     /// [`Light::sample`] of every `u` of `us`, appended to `out` (the same values, computed with the
     /// same operations: a parallelogram's edge vectors are only computed once).
     pub fn sample_into(&self, us: &[Vec2], out: &mut Vec<Vec3>) {
-        if self.parallelogram {
-            let v = &self.vertices;
-            let (o, e1, e3) = (v[0], v[1] - v[0], v[3] - v[0]);
+        if let Some((o, e1, e3)) = self.parallelogram_edges() {
             out.extend(us.iter().map(|u| o + e1 * u.x + e3 * u.y));
         } else {
             out.extend(us.iter().map(|&u| self.sample(u)));
