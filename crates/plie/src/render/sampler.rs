@@ -52,7 +52,7 @@ impl Rng {
 /// points, the shuffle's index (the low 16 bits). The rows are shuffled inside-out (Durstenfeld's
 /// forward form): point `i` takes the row of a random earlier point `j <= i`, which takes row `i`.
 /// The draws are counter-based, so up to [`SHORT_SHUFFLE`] points they are made for all points at
-/// once ([`draw_points`], in lanes), and the shuffle follows.
+/// once, in lanes, and the shuffle follows.
 pub fn n_rooks(rng: &mut Rng, out: &mut [Vec2]) {
     let n = out.len();
     if n > SHORT_SHUFFLE {
