@@ -42,6 +42,16 @@ impl Pyramid {
         // The sample domain's hull is the polygon (plus, for a parallelogram, its fourth corner
         // recomputed, within rounding of the vertex): the polygon's edges, grown by the margin.
         let toward_centre = light.center() - x;
+        if v.len() <= 4 {
+            self.set_sides_lanes(x, v, toward_centre)
+        } else {
+            self.set_sides(x, v, toward_centre)
+        }
+    }
+
+    /// The side planes of the polygon `v` seen from `x`, one edge at a time; false (and no sides)
+    /// if an edge's plane is not well defined.
+    fn set_sides(&mut self, x: Vec3, v: &[Vec3], toward_centre: Vec3) -> bool {
         // Each edge (v[i], v[i + 1]), the last closing the polygon, relative to the apex.
         let mut q = v[0] - x;
         let first = q;
@@ -66,6 +76,36 @@ impl Pyramid {
             let lane = |f: fn(Vec3) -> f32| Vec4::new(f(side(0)), f(side(1)), f(side(2)), f(side(3)));
             self.lanes = Some([lane(|v| v.x), lane(|v| v.y), lane(|v| v.z)]);
         }
+        true
+    }
+
+    /// [`Pyramid::set_sides`] for a triangle or a quadrilateral, its edges in four lanes (a
+    /// triangle's last edge twice): the same operations in the same order (`Vec3::cross`,
+    /// `length`, the division, `dot`), so the same planes, bit for bit.
+    fn set_sides_lanes(&mut self, x: Vec3, v: &[Vec3], toward_centre: Vec3) -> bool {
+        let n = v.len();
+        // Edge i runs from corner i to corner i + 1 (the last back to corner 0).
+        let corner = |i: usize| v[i.min(n - 1)] - x;
+        let next = |i: usize| if i + 1 < n { v[i + 1] - x } else { v[0] - x };
+        let lanes = |f: &dyn Fn(usize) -> Vec3, axis: usize| Vec4::new(f(0)[axis], f(1)[axis], f(2)[axis], f(3)[axis]);
+        let (px, py, pz) = (lanes(&corner, 0), lanes(&corner, 1), lanes(&corner, 2));
+        let edge_end = |i: usize| next(i.min(n - 1));
+        let (qx, qy, qz) = (lanes(&edge_end, 0), lanes(&edge_end, 1), lanes(&edge_end, 2));
+        // p x q, as `Vec3::cross`.
+        let (sx, sy, sz) = (py * qz - qy * pz, pz * qx - qz * px, px * qy - qx * py);
+        let len = (sx * sx + sy * sy + sz * sz).sqrt();
+        debug_assert!(n >= 3);
+        if !len.is_finite() || len.cmple(Vec4::ZERO).any() {
+            self.sides.clear();
+            return false;
+        }
+        let (sx, sy, sz) = (sx / len, sy / len, sz / len);
+        let flip = (sx * toward_centre.x + sy * toward_centre.y + sz * toward_centre.z).cmplt(Vec4::ZERO);
+        let (sx, sy, sz) = (Vec4::select(flip, -sx, sx), Vec4::select(flip, -sy, sy), Vec4::select(flip, -sz, sz));
+        for i in 0..n {
+            self.sides.push(Vec3::new(sx[i], sy[i], sz[i]));
+        }
+        self.lanes = Some([sx, sy, sz]);
         true
     }
 
@@ -267,5 +307,32 @@ mod tests {
             }
         }
         assert!(culled > 1000 && culled < 39_000, "{culled}");
+    }
+
+    /// The planes of a triangle or quadrilateral computed in lanes are the edge-by-edge loop's, bit
+    /// for bit, and both refuse the same degenerate apexes (on an edge's line).
+    #[test]
+    fn lane_sides_equal_the_loop() {
+        let mut rng = Rng::stream(11, 0, 0, 0);
+        let mut r = |scale: f32| (rng.next_f32() - 0.5) * scale;
+        let bits = |p: &Pyramid| {
+            let sides: Vec<[u32; 3]> = p.sides.iter().map(|s| s.to_array().map(f32::to_bits)).collect();
+            let lanes = p.lanes.map(|l| l.map(|v| v.to_array().map(f32::to_bits)));
+            (sides, lanes)
+        };
+        let mut refused = 0;
+        for k in 0..400 {
+            let n = 3 + k % 2;
+            let v: Vec<Vec3> = (0..n).map(|_| Vec3::new(r(4.0), 3.0 + r(0.1), r(4.0))).collect();
+            // Every tenth apex on the line of the first edge: no plane there.
+            let x = if k % 10 == 0 { v[0] + (v[1] - v[0]) * 2.0 } else { Vec3::new(r(8.0), r(2.0), r(8.0)) };
+            let toward = v.iter().copied().sum::<Vec3>() / n as f32 - x;
+            let (mut a, mut b) = (Pyramid::default(), Pyramid::default());
+            let (ra, rb) = (a.set_sides(x, &v, toward), b.set_sides_lanes(x, &v, toward));
+            assert_eq!(ra, rb, "apex {x}, light {v:?}");
+            assert_eq!(bits(&a), bits(&b), "apex {x}, light {v:?}");
+            refused += usize::from(!ra);
+        }
+        assert!(refused >= 20, "{refused}");
     }
 }
