@@ -63,44 +63,50 @@ impl Shaft {
         Shaft::hull(pts, bounds, tol)
     }
 
-    /// The shaft of `conv(b ∪ light)` for a box `b` and a convex polygon `light`, grown by `tol`:
-    /// [`Shaft::of_points`] of the box's corners and the polygon, from fewer candidate planes. Each
-    /// facet of that hull is a face of the box, the polygon's plane, or holds an edge of one and a
-    /// vertex of the other, so only those triples are tried (106 for a quadrilateral, against 220
-    /// triples of the twelve points); each is kept, as there, only if every point lies on one side.
-    /// The cuts of the scene BVH use it ([`crate::visibility::bvh::Cut`]).
-    pub fn of_box_and_polygon(b: &Aabb, light: &[Vec3], tol: f32) -> Shaft {
-        let corners = b.corners();
-        let bounds = Aabb::from_points(light.iter().chain(&corners)).expanded(tol);
-        let pts: Vec<DVec3> = corners.iter().chain(light).map(|p| p.as_dvec3()).collect();
-        let k = light.len();
-        let mut planes = Vec::new();
-        let found = HullPoints::new(&pts);
-        // The box's faces: three corners of each (bit `a` of a corner's index is its side on axis `a`).
-        for a in 0..3 {
-            let (u, v) = (1 << ((a + 1) % 3), 1 << ((a + 2) % 3));
-            for side in [0, 1 << a] {
-                found.try_plane::<true>(side, side | u, side | v, &mut planes);
-            }
-        }
-        // The polygon's vertices, in `f32`, need not lie in one plane: its facets are any three of
-        // them, and its edges with a box corner any two.
-        for u in 0..k {
-            for v in u + 1..k {
-                for w in v + 1..k {
-                    found.try_plane::<true>(8 + u, 8 + v, 8 + w, &mut planes);
-                }
-                for c in 0..8 {
-                    found.try_plane::<true>(8 + u, 8 + v, c, &mut planes);
-                }
-            }
-        }
-        // A box edge and a polygon vertex.
-        for c in 0..8 {
-            for bit in [1, 2, 4] {
-                if c & bit == 0 {
-                    for v in 0..k {
-                        found.try_plane::<true>(c, c | bit, 8 + v, &mut planes);
+    /// The shaft of `conv(a ∪ b)` for two boxes, grown by `tol` (the shafts of the cuts of the scene
+    /// BVH, [`crate::visibility::bvh::Cut`]: a leaf's box and a light's). A facet of that hull whose
+    /// normal has three non-zero components would meet each box in one corner only, so every facet
+    /// is a face of the boxes' bounds or parallel to an axis. Those parallel to axis `e` are the
+    /// lines of the hull of the two rectangles the boxes project to along `e`: through a corner of
+    /// each, with all eight corners on one side. So this is [`Shaft::of_points`] of the sixteen
+    /// corners, from 3 x 16 candidate lines instead of 560 triples.
+    pub fn of_boxes(a: &Aabb, b: &Aabb, tol: f32) -> Shaft {
+        let bounds = a.union(*b).expanded(tol);
+        let mut planes: Vec<Plane> = Vec::with_capacity(12);
+        for e in 0..3 {
+            let (u, v) = ((e + 1) % 3, (e + 2) % 3);
+            let rect = |r: &Aabb| {
+                let (lo, hi) = (r.min.as_dvec3(), r.max.as_dvec3());
+                [[lo[u], lo[v]], [hi[u], lo[v]], [lo[u], hi[v]], [hi[u], hi[v]]]
+            };
+            let (ra, rb) = (rect(a), rect(b));
+            let all = [ra[0], ra[1], ra[2], ra[3], rb[0], rb[1], rb[2], rb[3]];
+            for p in ra {
+                for q in rb {
+                    let (du, dv) = (q[0] - p[0], q[1] - p[1]);
+                    // A line along an axis (or no line) is a face of the bounds, planes already.
+                    if du == 0.0 || dv == 0.0 {
+                        continue;
+                    }
+                    // Which side of the line through `p` and `q` each corner lies on: all on one.
+                    let (mut below, mut above) = (false, false);
+                    for x in all {
+                        let s = dv * (x[0] - p[0]) - du * (x[1] - p[1]);
+                        below |= s < 0.0;
+                        above |= s > 0.0;
+                    }
+                    if below && above {
+                        continue;
+                    }
+                    let sign = if above { -1.0 } else { 1.0 };
+                    let mut n = DVec3::ZERO;
+                    (n[u], n[v]) = (sign * dv, -sign * du);
+                    let n = n / n.length();
+                    // Through `p` (and `q`): every corner inside, but for rounding far below `tol`.
+                    let plane = Plane { n, d: n[u] * p[0] + n[v] * p[1] };
+                    // Corners that project to one point give the same line more than once.
+                    if !planes.contains(&plane) {
+                        planes.push(plane);
                     }
                 }
             }
@@ -117,7 +123,7 @@ impl Shaft {
         for i in 0..n {
             for j in i + 1..n {
                 for k in j + 1..n {
-                    found.try_plane::<false>(i, j, k, &mut planes);
+                    found.try_plane(i, j, k, &mut planes);
                 }
             }
         }
@@ -236,9 +242,9 @@ impl<'a> HullPoints<'a> {
 
     /// Adds the plane through points `i`, `j`, `k` to `planes`, facing away from the points, if
     /// every point lies on one side of it (within a relative slack, by which it is moved out) and
-    /// no plane of `planes` is the same. `EARLY`: stop at the first points on both sides.
+    /// no plane of `planes` is the same.
     #[inline(always)]
-    fn try_plane<const EARLY: bool>(&self, i: usize, j: usize, k: usize, planes: &mut Vec<Plane>) {
+    fn try_plane(&self, i: usize, j: usize, k: usize, planes: &mut Vec<Plane>) {
         let (pts, scale) = (self.pts, self.scale);
         let normal = (pts[j] - pts[i]).cross(pts[k] - pts[i]);
         let len = normal.length();
@@ -248,30 +254,10 @@ impl<'a> HullPoints<'a> {
         let nn = normal / len;
         let d = nn.dot(pts[i]);
         let slack = 1e-9 * scale;
-        let (lo, hi) = if EARLY {
-            let (mut lo, mut hi) = (f64::MAX, f64::MIN);
-            for p in pts {
-                let s = nn.dot(*p) - d;
-                // Plain comparisons (no value here is NaN: f32 coordinates cannot overflow f64).
-                if s < lo {
-                    lo = s;
-                }
-                if s > hi {
-                    hi = s;
-                }
-                // Points on both sides: not a supporting plane.
-                if lo < -slack && hi > slack {
-                    return;
-                }
-            }
-            (lo, hi)
-        } else {
-            // Without the exit: faster for construction's shafts of few points (measured).
-            pts.iter().fold((f64::MAX, f64::MIN), |(lo, hi), p| {
-                let s = nn.dot(*p) - d;
-                (lo.min(s), hi.max(s))
-            })
-        };
+        let (lo, hi) = pts.iter().fold((f64::MAX, f64::MIN), |(lo, hi), p| {
+            let s = nn.dot(*p) - d;
+            (lo.min(s), hi.max(s))
+        });
         let cand = if hi <= slack {
             Plane { n: nn, d: d + hi.max(0.0) }
         } else if lo >= -slack {
@@ -344,29 +330,29 @@ mod tests {
         assert!(s.clips_triangle(&near));
     }
 
-    /// The box-and-polygon shaft has the planes of the general one (the same supporting planes, up
-    /// to rounding), on random boxes and tilted convex lights.
+    /// The two-box shaft has the planes of the general one over the sixteen corners (the same
+    /// supporting planes, up to rounding), on random boxes, flat ones among them.
     #[test]
-    fn box_and_polygon_shaft_has_the_hull_planes() {
-        let mut state = 5u64;
+    fn two_box_shaft_has_the_hull_planes() {
+        let mut state = 9u64;
         let mut rnd = || {
             state = crate::render::sampler::mix64(state);
             (state >> 40) as f32 / (1u64 << 24) as f32
         };
+        let mut boxes = |flat: bool| {
+            let p = Vec3::new(rnd(), rnd(), rnd()) * 20.0 - 5.0;
+            let mut size = Vec3::new(rnd(), rnd(), rnd()) * 3.0 + 0.01;
+            if flat {
+                size[(rnd() * 3.0) as usize % 3] = 0.0;
+            }
+            Aabb { min: p, max: p + size }
+        };
+        let mut planes = 0;
         for case in 0..500 {
-            let p = Vec3::new(rnd(), rnd(), rnd()) * 10.0;
-            let b = Aabb { min: p, max: p + Vec3::new(rnd(), rnd(), rnd()) * 3.0 + 0.01 };
-            let c = Vec3::new(rnd() * 20.0 - 5.0, rnd() * 20.0 - 5.0, rnd() * 20.0 - 5.0);
-            let (e1, e2) = (Vec3::new(rnd(), rnd() * 0.5, rnd()), Vec3::new(rnd() * 0.3, rnd(), -rnd()));
-            let sides = 3 + case % 4;
-            let light: Vec<Vec3> = (0..sides)
-                .map(|v| {
-                    let a = v as f32 / sides as f32 * std::f32::consts::TAU;
-                    c + e1 * a.cos() + e2 * a.sin()
-                })
-                .collect();
-            let general = Shaft::of_points(&b.corners(), &light, 1e-4);
-            let fast = Shaft::of_box_and_polygon(&b, &light, 1e-4);
+            let (a, b) = (boxes(false), boxes(case % 2 == 0));
+            let corners: Vec<Vec3> = a.corners().into_iter().chain(b.corners()).collect();
+            let general = Shaft::of_points(&corners[..8], &corners[8..], 1e-4);
+            let fast = Shaft::of_boxes(&a, &b, 1e-4);
             let has =
                 |s: &Shaft, q: &Plane| s.planes.iter().any(|p| p.n.dot(q.n) > 1.0 - 1e-6 && (p.d - q.d).abs() < 1e-3);
             for q in &general.planes {
@@ -375,6 +361,11 @@ mod tests {
             for q in &fast.planes {
                 assert!(has(&general, q), "case {case}: {q:?} extra");
             }
+            // Every corner inside every plane (moved out by the tolerance, and no further).
+            assert!(corners.iter().all(|c| fast.planes.iter().all(|p| p.distance(c.as_dvec3()) <= 1e-4)));
+            planes += fast.planes.len() - 6;
         }
+        // Most hulls have slanted facets (else the test would check only the bounds).
+        assert!(planes > 1000, "{planes} slanted planes in 500 hulls");
     }
 }

@@ -10,7 +10,7 @@
 //! It keeps its entries' boxes (decoded from their parents as a walk decodes them) and what they
 //! lead to, so a walk reads one cut and no parent node.
 
-use glam::Vec3;
+use glam::{DVec3, Vec3};
 use obvhs::cwbvh::node::CwBvhNode;
 
 use super::{Bvh, PAD};
@@ -20,6 +20,10 @@ use crate::geometry::Aabb;
 /// Most entries of a cut: one node's worth of box lanes. Measured (callgrind at 64 rays): 16 cost
 /// more than 8 on huis-c, cornell-bunny and cornell-dragon-100k, and less on conference-lit.
 pub(crate) const CUT_MAX: usize = 8;
+
+/// Most slanted planes of the hull of two boxes ([`Shaft::of_boxes`]): four lines bridge two
+/// rectangles, per axis.
+const SLANTED_MAX: usize = 12;
 
 /// What a cut's entry (a child of a BVH node) leads to.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -62,19 +66,35 @@ pub(crate) struct Cut {
 }
 
 impl Bvh {
-    /// The cut of the hull of the box `b` and the light polygon `light`, grown by `pad`: the hull
-    /// holds every segment from a point of `b` to a point of the light.
+    /// The cut of the hull of the box `b` and the bounding box of the light polygon `light`, grown
+    /// by `pad`: the hull holds every segment from a point of `b` to a point of the light.
     pub(crate) fn cut_of(&self, b: &Aabb, light: &[Vec3], pad: f32) -> Cut {
-        let shaft = Shaft::of_box_and_polygon(b, light, pad);
+        let shaft = Shaft::of_boxes(b, &Aabb::from_points(light), pad);
         // The region is the shaft's bounds (the box and the light, grown by `pad`), and `cut` keeps
-        // only boxes that meet it: the supporting planes are left to test.
-        self.cut(&shaft.bounds, |b| shaft.may_overlap_box_in_bounds(b))
+        // only boxes that meet it: the shaft's other planes are left to test. A box of centre `c`
+        // and half-size `h` in normalised units, grown by twice the padding there, may meet the
+        // plane `n . p <= d` (world units) if `n . c - |n| . h + k <= 0`, with `k` as below
+        // (multiplied through by the scale; in `f64`, far below the padding in rounding).
+        let (origin, scale) = (self.origin.as_dvec3(), f64::from(self.scale));
+        let mut planes = [(DVec3::ZERO, DVec3::ZERO, 0.0f64); SLANTED_MAX];
+        let slanted = &shaft.planes[..shaft.planes.len() - 6];
+        debug_assert!(slanted.len() <= SLANTED_MAX);
+        for (to, p) in planes.iter_mut().zip(slanted) {
+            let k = (p.n.dot(origin) - p.d) * scale - 2.0 * f64::from(PAD) * p.n.abs().element_sum();
+            *to = (p.n, p.n.abs(), k);
+        }
+        let planes = &planes[..slanted.len().min(SLANTED_MAX)];
+        self.cut(&shaft.bounds, |lo, hi| {
+            let (c, h) = (((lo + hi) * 0.5).as_dvec3(), ((hi - lo) * 0.5).as_dvec3());
+            planes.iter().all(|(n, a, k)| n.dot(c) - a.dot(h) + k <= 0.0)
+        })
     }
 
     /// The cut of the region `region` (world units; see the module documentation), keeping only the
-    /// children whose boxes (in world units, grown by twice the padding) `keep` accepts: `keep` must
-    /// accept every box that meets a segment of the fans the cut serves. An empty BVH has an empty cut.
-    fn cut(&self, region: &Aabb, keep: impl Fn(&Aabb) -> bool) -> Cut {
+    /// children whose boxes (in normalised units, as `(lo, hi)`, not grown) `keep` accepts: `keep`
+    /// must accept every box that, grown by twice the padding, meets a segment of the fans the cut
+    /// serves. An empty BVH has an empty cut.
+    fn cut(&self, region: &Aabb, keep: impl Fn(Vec3, Vec3) -> bool) -> Cut {
         let mut cut = Cut::default();
         if self.cw.nodes.is_empty() {
             return cut;
@@ -83,54 +103,64 @@ impl Bvh {
         // conversion).
         let lo = Vec3::from(self.to_local(region.min)) - Vec3::splat(PAD);
         let hi = Vec3::from(self.to_local(region.max)) + Vec3::splat(PAD);
-        let to_world = |p: Vec3| p / self.scale + self.origin;
-        let pad = Vec3::splat(2.0 * PAD / self.scale);
-        let meets = |(clo, chi): (Vec3, Vec3)| {
-            clo.cmple(hi).all()
-                && chi.cmpge(lo).all()
-                && keep(&Aabb { min: to_world(clo) - pad, max: to_world(chi) + pad })
-        };
-        let children = |n: u32| {
+        let meets = |(clo, chi): (Vec3, Vec3)| clo.cmple(hi).all() && chi.cmpge(lo).all() && keep(clo, chi);
+        /// An entry: the parent node, the child's slot, its box's area, and whether it is an inner
+        /// node that may still be expanded (not a leaf, not found too wide to expand).
+        type Entry = (u32, u8, f32, bool);
+        // The children of node `n` that meet the region, into `to`; their count.
+        let children = |n: u32, to: &mut [Entry; 8]| {
             let node = &self.cw.nodes[n as usize];
-            (0..8).filter(move |&c| node.child_meta[c] != 0 && meets(self.child_box(n, c)))
+            let mut len = 0;
+            for c in 0..8 {
+                if node.child_meta[c] == 0 {
+                    continue;
+                }
+                let (a, b) = self.child_box(n, c);
+                if meets((a, b)) {
+                    let d = b - a;
+                    to[len] = (n, c as u8, d.x * d.y + d.y * d.z + d.z * d.x, !node.is_leaf(c));
+                    len += 1;
+                }
+            }
+            len
         };
-        let mut entries: Vec<(u32, u8)> = children(0).map(|c| (0, c as u8)).collect();
-        // Inner entries too wide to expand within the limit.
-        let mut stuck: Vec<(u32, u8)> = Vec::new();
-        let area = |&(p, c): &(u32, u8)| {
-            let (a, b) = self.child_box(p, c as usize);
-            let d = b - a;
-            d.x * d.y + d.y * d.z + d.z * d.x
-        };
+        let mut inner = [(0, 0, 0.0, false); 8];
+        let mut entries = [(0, 0, 0.0, false); CUT_MAX];
+        // The root has at most eight children.
+        let mut len = children(0, &mut inner);
+        entries[..len].copy_from_slice(&inner[..len]);
         loop {
-            let next = entries
-                .iter()
-                .enumerate()
-                .filter(|(_, e)| !self.cw.nodes[e.0 as usize].is_leaf(e.1 as usize) && !stuck.contains(e))
-                .max_by(|a, b| area(a.1).total_cmp(&area(b.1)))
-                .map(|(i, &e)| (i, e));
-            let Some((i, (p, c))) = next else {
+            // The widest entry that may be expanded (the last of equals).
+            let mut next: Option<usize> = None;
+            for (i, e) in entries[..len].iter().enumerate() {
+                if e.3 && next.is_none_or(|j| e.2.total_cmp(&entries[j].2).is_ge()) {
+                    next = Some(i);
+                }
+            }
+            let Some(i) = next else {
                 break;
             };
+            let (p, c) = (entries[i].0, entries[i].1);
             let n = self.cw.nodes[p as usize].child_node_index(c as usize);
-            let inner: Vec<(u32, u8)> = children(n).map(|k| (n, k as u8)).collect();
-            if entries.len() - 1 + inner.len() > CUT_MAX {
-                stuck.push((p, c));
+            let k = children(n, &mut inner);
+            if len - 1 + k > CUT_MAX {
+                entries[i].3 = false;
                 continue;
             }
-            entries.swap_remove(i);
-            entries.extend(inner);
+            // The entry's place to the last one, then its children after them.
+            entries[i] = entries[len - 1];
+            len -= 1;
+            entries[len..len + k].copy_from_slice(&inner[..k]);
+            len += k;
         }
-        // The root has at most eight children, and every step keeps at most `CUT_MAX`.
-        debug_assert!(entries.len() <= CUT_MAX);
-        for (k, &(p, c)) in entries.iter().enumerate() {
+        for (k, &(p, c, ..)) in entries[..len].iter().enumerate() {
             let (lo, hi) = self.child_box(p, c as usize);
             for a in 0..3 {
                 (cut.lo[a][k], cut.hi[a][k]) = (lo[a], hi[a]);
             }
             cut.child[k] = Child::of(&self.cw.nodes[p as usize], c as usize);
         }
-        cut.len = entries.len() as u8;
+        cut.len = len as u8;
         cut
     }
 
@@ -182,7 +212,7 @@ mod tests {
             // The hull, to check against.
             let corners = b.corners();
             let region = Aabb::from_points(light.iter().chain(&corners)).expanded(pad);
-            let shaft = Shaft::of_box_and_polygon(&b, light, pad);
+            let shaft = Shaft::of_boxes(&b, &Aabb::from_points(light), pad);
             assert!(cut.len as usize <= super::CUT_MAX);
             // The triangles under the cut.
             let mut under = vec![false; scene.triangles.len()];
