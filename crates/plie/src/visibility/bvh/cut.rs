@@ -1,7 +1,7 @@
 //! Where a fan's walk down the scene BVH starts (issue 21; issue 15's "bounded cut"): for an octree
 //! leaf and a light, at most [`CUT_MAX`] children of BVH nodes whose boxes hold every triangle box
-//! that meets the hull of the leaf's box and the light polygon. A fan from a point of the leaf to the
-//! light lies inside that hull, so testing the cut's boxes as the children of one node
+//! that meets the hull of the leaf's box and the light's bounding box ([`Shaft::of_boxes`]). A fan
+//! from a point of the leaf to the light lies inside that hull, so testing the cut's boxes as the children of one node
 //! ([`super::Bvh::fan_occluded`]) reaches every triangle a walk from the root would, without
 //! visiting the nodes above the cut.
 //!
