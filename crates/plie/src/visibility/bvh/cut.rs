@@ -1,9 +1,9 @@
 //! Where a fan's walk down the scene BVH starts (issue 21; issue 15's "bounded cut"): for an octree
 //! leaf and a light, at most [`CUT_MAX`] children of BVH nodes whose boxes hold every triangle box
 //! that meets the hull of the leaf's box and the light's bounding box ([`Shaft::of_boxes`]). A fan
-//! from a point of the leaf to the light lies inside that hull, so testing the cut's boxes as the children of one node
-//! ([`super::Bvh::fan_occluded`]) reaches every triangle a walk from the root would, without
-//! visiting the nodes above the cut.
+//! from a point of the leaf to the light lies inside that hull, so testing the cut's boxes as the
+//! children of one node ([`super::Bvh::fan_occluded`]) reaches every triangle a walk from the root
+//! would, without visiting the nodes above the cut.
 //!
 //! The cut is chosen greedily: the root's children that meet the region, then the inner child with
 //! the largest box replaced by its own children that meet it, as long as at most [`CUT_MAX`] remain.
@@ -126,7 +126,8 @@ impl Bvh {
         };
         let mut inner = [(0, 0, 0.0, false); 8];
         let mut entries = [(0, 0, 0.0, false); CUT_MAX];
-        // The root has at most eight children.
+        // The root has at most eight children, all of which fit.
+        const { assert!(CUT_MAX >= 8) };
         let mut len = children(0, &mut inner);
         entries[..len].copy_from_slice(&inner[..len]);
         loop {
