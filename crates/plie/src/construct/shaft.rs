@@ -146,21 +146,9 @@ impl Shaft {
 
     /// False if the box lies entirely outside one of the planes (then nothing in it touches the shaft).
     pub fn may_overlap_box(&self, b: &Aabb) -> bool {
-        Shaft::box_within(&self.planes, b)
-    }
-
-    /// [`Shaft::may_overlap_box`] for a box known to meet the shaft's `bounds`: the supporting
-    /// planes only (the six planes of the bounds, last, are left out).
-    pub fn may_overlap_box_in_bounds(&self, b: &Aabb) -> bool {
-        Shaft::box_within(&self.planes[..self.planes.len().saturating_sub(6)], b)
-    }
-
-    /// False if the box lies entirely outside one of `planes`.
-    #[inline]
-    fn box_within(planes: &[Plane], b: &Aabb) -> bool {
         let c = b.center().as_dvec3();
         let h = (b.size() * 0.5).as_dvec3();
-        planes.iter().all(|p| p.distance(c) - h.dot(p.n.abs()) <= 0.0)
+        self.planes.iter().all(|p| p.distance(c) - h.dot(p.n.abs()) <= 0.0)
     }
 
     /// True if the triangle has a non-empty intersection with the (grown) shaft: Sutherland-Hodgman

@@ -185,9 +185,9 @@ const CUTS_MAX_BYTES: u64 = 256 << 20;
 
 impl LieVisibility<'_> {
     /// The cut of the scene BVH for `leaf` and `light`: the children whose boxes meet the hull of
-    /// the leaf's box and the light's bounding box (grown by the scene tolerance), which holds every segment
-    /// from a point of the leaf to a point of the light. Computed on first use (any thread computes
-    /// the same cut); `None` without a cut table.
+    /// the leaf's box and the light's bounding box (grown by the scene tolerance), which holds every
+    /// segment from a point of the leaf to a point of the light. Computed on first use (any thread
+    /// computes the same cut); `None` without a cut table.
     #[inline]
     fn cut(&self, leaf: LeafId, light: LightId) -> Option<&Cut> {
         let slot = self.cuts.get(leaf.idx() * self.scene.lights.len() + light.idx())?;
