@@ -118,7 +118,7 @@ pub fn run(a: &Args, matches: &clap::ArgMatches) -> Result<()> {
     let bar = Bar::new(a.quiet || a.json);
     let Loaded { env, .. } = match a.plie.as_deref() {
         Some(file) => load_file(&scene, file, &a.params, matches)?,
-        None => build(&scene, params, &bar)?,
+        None => build(&scene, params, &a.params, &bar)?,
     };
     let (octree, plie) = (env.octree(), env.plie());
     let inspector = Inspector::new(&scene, octree, plie)?;

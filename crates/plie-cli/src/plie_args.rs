@@ -59,9 +59,15 @@ pub struct PlieArgs {
     /// rays are answered by the scene BVH (exact either way). Bounds construction time and memory.
     #[arg(long, value_name = "N|none", default_value_t = BlockerCap(Some(plie::DEFAULT_BLOCKER_CAP)), value_parser = parse_blocker_cap)]
     pub blocker_cap: BlockerCap,
+    /// P-LIE: candidate triangles per scene triangle the build may clip to give records over
+    /// --blocker-cap their full lists anyway (with a cap up to 16 times larger), spent in a fixed
+    /// order; or `none`. Where few records pass the cap (an open room) nearly all get their lists;
+    /// where most do (dense clutter) the budget bounds the extra time. Exact either way.
+    #[arg(long, value_name = "N|none", default_value_t = BlockerCap(Some(plie::DEFAULT_LIFT_CLIPS as u32)), value_parser = parse_lift_clips)]
+    pub lift_clips: BlockerCap,
 }
 
-/// A value of `--blocker-cap`: a number, or `None` for `none`.
+/// A value of `--blocker-cap` or `--lift-clips`: a number, or `None` for `none`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct BlockerCap(pub Option<u32>);
 
@@ -81,6 +87,15 @@ fn parse_blocker_cap(s: &str) -> std::result::Result<BlockerCap, String> {
     s.parse::<u32>()
         .map(|n| BlockerCap(Some(n)))
         .map_err(|_| format!("expected a number of blockers or `none`, not `{s}`"))
+}
+
+fn parse_lift_clips(s: &str) -> std::result::Result<BlockerCap, String> {
+    if s == "none" {
+        return Ok(BlockerCap(None));
+    }
+    s.parse::<u32>()
+        .map(|n| BlockerCap(Some(n)))
+        .map_err(|_| format!("expected a number of clips or `none`, not `{s}`"))
 }
 
 /// A value of `--refine`.
@@ -120,6 +135,11 @@ impl PlieArgs {
         p.octree().validate()?;
         p.refine.validate(p.has_regions())?;
         Ok(p)
+    }
+
+    /// `--lift-clips`: candidate clips per scene triangle ([`BuildOptions::lift_clips`]).
+    pub fn lift_clips(&self) -> Option<usize> {
+        self.lift_clips.0.map(|n| n as usize)
     }
 
     /// The refinement asked for.
@@ -256,10 +276,11 @@ pub struct Loaded {
 }
 
 /// Builds the octree and the P-LIE of `scene` (refined if `params` asks) within the default memory
-/// budget.
-pub fn build(scene: &Scene, params: PlieParams, bar: &Bar) -> Result<Loaded> {
+/// budget, lifting the cap as `args` says.
+pub fn build(scene: &Scene, params: PlieParams, args: &PlieArgs, bar: &Bar) -> Result<Loaded> {
     let list_bytes = Some(crate::budget::list_bytes(crate::budget::default_bytes(), scene));
-    let (env, stats) = Environment::build_with(scene, &params, BuildOptions { list_bytes, progress: bar })?;
+    let options = BuildOptions { list_bytes, lift_clips: args.lift_clips(), progress: bar };
+    let (env, stats) = Environment::build_with(scene, &params, options)?;
     crate::budget::warn_over(&stats, bar);
     Ok(Loaded { env, build_seconds: Some(stats.blockers.blockers_seconds), load_seconds: None })
 }

@@ -118,7 +118,7 @@ pub fn run(a: &Args, matches: &clap::ArgMatches) -> Result<()> {
     let loaded = if asked.needs_plie() || plie_file.is_some() {
         Some(match plie_file {
             Some(file) => load_file(&scene, file, &a.params, matches)?,
-            None => build(&scene, params, &bar)?,
+            None => build(&scene, params, &a.params, &bar)?,
         })
     } else {
         None

@@ -25,9 +25,16 @@ fn build_json_reports_the_bounds_and_the_budget_degrades_without_aborting() {
     let out = dir.path().join("b.plie");
     let out = out.to_str().unwrap();
     let base = ["build", "--scene", "balusters-12", "-o", out, "--json"];
+    // Lifting the cap (on by default) gives these few records over it their full lists.
     let (v, _) = build_json(&[&base[..], &["--blocker-cap", "24"]].concat());
+    assert_eq!(v["lift_clips"], plie::DEFAULT_LIFT_CLIPS);
+    assert!(v["records_lifted"].as_u64().unwrap() > 0, "{v}");
+    let lifted_scene = v["records_scene"].as_u64().unwrap();
+    let (v, _) = build_json(&[&base[..], &["--blocker-cap", "24", "--lift-clips", "none"]].concat());
     assert_eq!(v["blocker_cap"], 24);
-    assert!(v["records_scene"].as_u64().unwrap() > 0, "{v}");
+    assert!(v["lift_clips"].is_null(), "{v}");
+    assert_eq!(v["records_lifted"], 0, "{v}");
+    assert!(v["records_scene"].as_u64().unwrap() > lifted_scene, "{v}");
     assert_eq!(v["records_over_budget"], 0, "{v}");
     assert!(v["peak_memory_bytes"].as_u64().unwrap() > 1 << 20, "{v}");
     let list = v["list_bytes"].as_u64().unwrap();
@@ -35,10 +42,14 @@ fn build_json_reports_the_bounds_and_the_budget_degrades_without_aborting() {
     // A budget that leaves the lists almost nothing: the build degrades, says so, and succeeds.
     let tri = v["triangles"].as_u64().unwrap();
     let tight = (256u64 << 20) + 1024 * tri + 2 * (list / 4);
-    let o = plie(&[&base[..4], &[out, "--blocker-cap", "24", "--memory-budget", &tight.to_string()]].concat());
+    let o = plie(
+        &[&base[..4], &[out, "--blocker-cap", "24", "--lift-clips", "none", "--memory-budget", &tight.to_string()]]
+            .concat(),
+    );
     assert!(o.status.success(), "{}", stderr(&o));
     assert!(stderr(&o).contains("memory budget reached"), "{}", stderr(&o));
-    let (v, _) = build_json(&[&base[..], &["--blocker-cap", "24", "--memory-budget", &tight.to_string()]].concat());
+    let tight_args = ["--blocker-cap", "24", "--lift-clips", "none", "--memory-budget", &tight.to_string()];
+    let (v, _) = build_json(&[&base[..], &tight_args].concat());
     assert!(v["records_over_budget"].as_u64().unwrap() > 0, "{v}");
     assert!(v["list_bytes"].as_u64().unwrap() <= list / 4, "{v}");
     // The file it wrote renders like a build without the budget would (exact either way).
@@ -97,6 +108,9 @@ fn bad_bounds_are_one_line_errors() {
     };
     for (budget, needle) in [("lots", "unit"), ("-4G", "error"), ("0", "positive"), ("4Q", "unit")] {
         refused(&["--memory-budget", budget], needle);
+    }
+    for clips in ["lots", "1e9", "99999999999"] {
+        refused(&["--lift-clips", clips], "expected a number of clips or `none`");
     }
     refused(&["--blocker-cap", "many"], "none");
     fails_with(&["build", "--scene", "balusters-2", "-o", out, "--memory-budget", "1K"], "below");

@@ -35,13 +35,17 @@ pub struct BuildOptions<'p> {
     /// Bytes the blocker lists may take ([`Limits::list_bytes`]); records over it are answered by
     /// the scene BVH (exactly). `None`: no limit.
     pub list_bytes: Option<usize>,
+    /// Candidate clips per scene triangle the build may spend giving records over the blocker cap
+    /// their full lists anyway, with a cap up to 16 times larger
+    /// ([`Limits::lift_clips`]); `None`: records over the cap stay answered by the scene BVH.
+    pub lift_clips: Option<usize>,
     /// Reports progress; [`Progress::cancelled`] stops the build with [`Error::Interrupted`].
     pub progress: &'p dyn Progress,
 }
 
 impl Default for BuildOptions<'_> {
     fn default() -> Self {
-        BuildOptions { list_bytes: None, progress: &NoProgress }
+        BuildOptions { list_bytes: None, lift_clips: Some(crate::DEFAULT_LIFT_CLIPS), progress: &NoProgress }
     }
 }
 
@@ -86,12 +90,14 @@ impl Environment {
         let t = std::time::Instant::now();
         let octree = Octree::build_valid(scene, params.octree());
         let octree_seconds = t.elapsed().as_secs_f64();
-        let limits = Limits { list_bytes: options.list_bytes };
+        let lift_clips = options.lift_clips.map(|c| c.saturating_mul(scene.triangles.len()));
+        let limits = Limits { list_bytes: options.list_bytes, lift_clips };
         let built = crate::construct::build_bounded(scene, octree, *params, limits, options.progress)
             .map_err(|_| Error::Interrupted)?;
         let mut stats = built.stats;
         stats.octree.octree_seconds = octree_seconds;
         stats.bounded.list_budget = options.list_bytes;
+        stats.bounded.lift_clips = options.lift_clips;
         Ok((Environment::from_parts(scene, built.octree, built.plie), stats))
     }
 

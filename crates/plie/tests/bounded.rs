@@ -236,7 +236,7 @@ fn the_memory_budget_degrades_records_in_task_order_and_stays_exact() {
     let params = PlieParams { blocker_cap: Some(256), ..PlieParams::default() };
     let free = build(&scene, params, Limits::default());
     let budget = free.stats.bounded.list_bytes / 3;
-    let limits = Limits { list_bytes: Some(budget) };
+    let limits = Limits { list_bytes: Some(budget), lift_clips: None };
     let tight = build(&scene, params, limits);
     assert!(tight.stats.bounded.records_over_budget > 0);
     assert!(tight.stats.bounded.list_bytes <= budget, "{} > {budget}", tight.stats.bounded.list_bytes);
@@ -247,6 +247,68 @@ fn the_memory_budget_degrades_records_in_task_order_and_stays_exact() {
     let single = one.install(|| build(&scene, params, limits));
     assert!(single.plie == tight.plie, "the budget's result depends on the thread count");
     assert!(check_exact(&scene, &tight, 10_000) > 100);
+}
+
+/// The records of `built` by (leaf, face, light).
+fn records_by_face(built: &plie::internals::construct::Built) -> std::collections::HashMap<(u32, usize, u32), usize> {
+    built.plie.records.iter().enumerate().map(|(i, r)| ((r.leaf.0, r.face.index(), r.light.0), i)).collect()
+}
+
+#[test]
+fn lifting_the_cap_gives_records_their_full_lists_and_stays_exact() {
+    let scene = balusters();
+    let cap = 8;
+    let params = PlieParams { blocker_cap: Some(cap), ..PlieParams::default() };
+    let capped = build(&scene, params, Limits::default());
+    let lifted = build(&scene, params, Limits { lift_clips: Some(usize::MAX / 4), ..Limits::default() });
+    let free = build(&scene, PlieParams { blocker_cap: None, ..params }, Limits::default());
+    let (l, c) = (&lifted.stats.bounded, &capped.stats.bounded);
+    // Every record over the cap was tried; some fit the lifted cap, some did not.
+    assert_eq!(l.records_lift_tried, c.records_scene, "{l:?}");
+    assert!(l.records_lifted > 20 && l.records_scene > 20, "{l:?}");
+    assert_eq!(lifted.plie.scene_records(), l.records_scene);
+    let max = cap as usize * plie::internals::construct::lift::LIFT_FACTOR as usize;
+    let free_records = records_by_face(&free);
+    let (mut same, mut over) = (0, 0);
+    for r in &lifted.plie.records {
+        let Some(&fi) = free_records.get(&(r.leaf.0, r.face.index(), r.light.0)) else { continue };
+        let full = free.plie.blockers_of(&free.plie.records[fi]);
+        if r.kind == RecordKind::Listed {
+            // A lifted record holds exactly the list it has without a cap.
+            let mut mine = lifted.plie.blockers_of(r).to_vec();
+            let mut theirs = full.to_vec();
+            mine.sort_unstable();
+            theirs.sort_unstable();
+            assert_eq!(mine, theirs, "{r:?}");
+            same += (r.blockers_len as usize > cap as usize) as usize;
+        } else {
+            assert!(full.len() > max, "{r:?}: {} blockers stayed over the lifted cap {max}", full.len());
+            over += 1;
+        }
+    }
+    assert!(same > 20 && over > 20, "{same} lifted lists, {over} over the lifted cap compared");
+    assert!(check_exact(&scene, &lifted, 20_000) > 100);
+}
+
+#[test]
+fn lifting_spends_at_most_its_budget_in_an_order_free_of_threads() {
+    let scene = balusters();
+    let params = PlieParams { blocker_cap: Some(8), ..PlieParams::default() };
+    let capped = build(&scene, params, Limits::default());
+    let budget = 2 * scene.triangle_count();
+    let limits = Limits { lift_clips: Some(budget), ..Limits::default() };
+    let lifted = build(&scene, params, limits);
+    let b = &lifted.stats.bounded;
+    assert!(b.records_lifted > 0, "{b:?}");
+    // The budget ran out before every record over the cap was tried.
+    assert!(b.records_lift_tried < capped.stats.bounded.records_scene, "{b:?}");
+    let spent = lifted.stats.blockers.candidates_clipped - capped.stats.blockers.candidates_clipped;
+    assert!(spent <= budget, "{spent} clips spent of a budget of {budget}");
+    let one = rayon::ThreadPoolBuilder::new().num_threads(1).build().unwrap();
+    let single = one.install(|| build(&scene, params, limits));
+    assert!(single.plie == lifted.plie, "the lifted cap's result depends on the thread count");
+    let none = build(&scene, params, Limits { lift_clips: Some(0), ..Limits::default() });
+    assert!(none.plie == capped.plie, "a budget of nothing lifts nothing");
 }
 
 #[test]

@@ -3,6 +3,7 @@
 
 use std::time::Instant;
 
+use super::lift::Lift;
 use super::refine::Refiner;
 use super::round::{Round, TaskRecords};
 use super::stats::{BuildStats, RoundStats};
@@ -19,6 +20,8 @@ pub(super) struct Totals {
     seconds: f64,
     /// With refinement: the first round's figures.
     pub(super) unrefined: Option<RoundStats>,
+    /// The lifting budget left and what lifting did.
+    pub(super) lift: Lift,
 }
 
 impl Totals {
@@ -48,6 +51,7 @@ pub(super) fn finish(
     stats.blockers.faces_considered = octree.leaf_count() * 6 * lights;
     stats.bounded.blocker_cap = params.blocker_cap;
     stats.bounded.records_over_budget = over_budget;
+    (stats.bounded.records_lift_tried, stats.bounded.records_lifted) = (totals.lift.tried, totals.lift.lifted);
     stats.regions.regions = params.has_regions();
     let p = &mut stats.propagation;
     p.enabled = params.propagation == crate::lie::Propagation::On;

@@ -3,7 +3,9 @@
 //!
 //! 1. [`data_objects`]: which (leaf, face, light) need a record (§4.1, exact condition).
 //! 2. [`shaft`]: bounding volume and supporting planes of conv(face ∪ light) (§4.2, §4.3).
-//! 3. [`blockers`]: gather candidates from the overlapping leaves, de-duplicate, clip (§4.4).
+//! 3. [`blockers`]: gather candidates from the overlapping leaves, de-duplicate, clip (§4.4). With a
+//!    blocker cap (issue 15), [`lift`] gathers the records over it again after the round with a
+//!    larger cap, while a budget of clips lasts.
 //! 4. [`regions`]: umbra and penumbra on the face (§4.5); a record fully in umbra is removed (§4.6).
 //! 5. [`grid`]: per record, a face grid of per-cell blocker lists with its umbra cells marked (our
 //!    addition, SPEC §8 points 2-4).
@@ -23,6 +25,7 @@ pub mod blockers;
 pub mod data_objects;
 mod flatten;
 pub mod grid;
+pub mod lift;
 pub mod propagation;
 mod record;
 pub mod refine;
@@ -38,6 +41,7 @@ use crate::lie::{Plie, PlieParams};
 use crate::octree::Octree;
 use crate::progress::Progress;
 use crate::scene::Scene;
+use lift::{lift_caps, Lift};
 use propagation::Propagated;
 use refine::Refiner;
 use round::{run_round, Prior};
@@ -69,6 +73,11 @@ pub struct Limits {
     /// made at the record's commit, in task order, so it does not depend on the thread count. `None`:
     /// no limit.
     pub list_bytes: Option<usize>,
+    /// Candidate clips the construction may spend gathering the records over the blocker cap again
+    /// with a cap up to [`lift::LIFT_FACTOR`] times larger ([`lift`]); in task order, so the result
+    /// does not depend on the thread count. `None`: no lifting (every record over the cap stays a
+    /// scene record).
+    pub lift_clips: Option<usize>,
 }
 
 /// The construction was interrupted ([`Progress::cancelled`]); nothing was built.
@@ -111,10 +120,12 @@ pub fn build_bounded(
     let mut octree = octree;
     let mut refiner = Refiner::new(&octree);
     let mut totals = flatten::Totals::default();
+    totals.lift = Lift::new(&limits);
     let mut prior = None;
     let round = loop {
         // Stages 1-6 for every (leaf, light), but those of leaves the last round did not split.
-        let round = run_round(scene, &octree, params, limits, progress, &refiner.stage(), prior.take())?;
+        let mut round = run_round(scene, &octree, params, limits, progress, &refiner.stage(), prior.take())?;
+        lift_caps(scene, &octree, params, &limits, progress, &mut round, &mut totals.lift)?;
         totals.add(&round);
         if !params.refine.enabled() {
             break round;

@@ -17,6 +17,9 @@ pub(super) struct PendingRecord {
     pub(super) regions: Option<regions::FaceRegions>,
     pub(super) grid: Option<grid::PendingGrid>,
     pub(super) kind: RecordKind,
+    /// A scene record because its gather passed the blocker cap: [`super::lift`] may gather it again
+    /// with a larger cap.
+    pub(super) liftable: bool,
 }
 
 impl PendingRecord {
@@ -35,7 +38,7 @@ impl PendingRecord {
             umbra: grid::umbra_cells(grid::UMBRA_MIN_RES, r),
             scene: true,
         });
-        PendingRecord { blockers: Vec::new(), regions, grid, kind: RecordKind::Scene }
+        PendingRecord { blockers: Vec::new(), regions, grid, kind: RecordKind::Scene, liftable: false }
     }
 
     /// Bytes its blocker lists (record and grid cells) will take in the P-LIE.
@@ -92,7 +95,7 @@ pub(super) fn face_record(
     let (record, state) = if let Some(reg) = regions.as_ref().filter(|r| r.full_umbra) {
         (None, FaceState::Dark { budget: propagation::dark_budget(face, &b, light, reg, tols) })
     } else if gathered.capped {
-        (Some(PendingRecord::scene(regions, params.has_grids())), FaceState::Kept)
+        (Some(PendingRecord { liftable: true, ..PendingRecord::scene(regions, params.has_grids()) }), FaceState::Kept)
     } else {
         let has_umbra = regions.as_ref().is_some_and(|r| !r.umbra.is_empty());
         let mut grid = if params.has_grids() {
@@ -111,7 +114,7 @@ pub(super) fn face_record(
                 crate::lie::order::sort_spatially(scene, list);
             }
         }
-        (Some(PendingRecord { blockers, regions, grid, kind: RecordKind::Listed }), FaceState::Kept)
+        (Some(PendingRecord { blockers, regions, grid, kind: RecordKind::Listed, liftable: false }), FaceState::Kept)
     };
     let candidates = gathered.candidates;
     FaceOut { record, state, candidates, seconds: t0.elapsed().as_secs_f64() }

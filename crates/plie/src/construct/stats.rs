@@ -77,6 +77,13 @@ pub struct BoundedStats {
     pub records_scene: usize,
     /// Of those, the records whose lists did not fit the list budget.
     pub records_over_budget: usize,
+    /// Candidate clips the construction could spend lifting the cap ([`crate::BuildOptions::lift_clips`],
+    /// per scene triangle); `None`: no lifting.
+    pub lift_clips: Option<usize>,
+    /// Records over the cap gathered again with a lifted cap (`construct::lift`).
+    pub records_lift_tried: usize,
+    /// Of those, the records that fit it: they hold their full lists (or were removed in umbra).
+    pub records_lifted: usize,
     /// Bytes of the blocker lists stored (records and grid cells).
     pub list_bytes: usize,
 }
@@ -225,7 +232,15 @@ impl fmt::Display for BoundedStats {
             self.records_scene,
             self.records_scene - self.records_over_budget,
             self.records_over_budget
-        )
+        )?;
+        match self.lift_clips {
+            None => writeln!(f, "lifted cap      none"),
+            Some(b) => writeln!(
+                f,
+                "lifted cap      {} of {} records over the cap gathered again hold their full lists ({b} clips per triangle)",
+                self.records_lifted, self.records_lift_tried
+            ),
+        }
     }
 }
 
@@ -363,6 +378,7 @@ mod tests {
             "blocker_cap",
             "records_scene",
             "records_over_budget",
+            "records_lifted",
             "list_bytes",
             "regions",
             "records_removed_umbra",
