@@ -195,7 +195,8 @@ impl Environment {
     /// defaults.
     #[staticmethod]
     #[pyo3(signature = (scene, *, max_triangles=200, max_depth=None, no_grids=false, no_regions=false,
-        no_propagation=false, refine=None, max_split_depth=2, max_blockers=None, blocker_cap=Some(64)))]
+        no_propagation=false, refine=None, max_split_depth=2, max_blockers=None, blocker_cap=Some(64),
+        lift_clips=Some(plie::DEFAULT_LIFT_CLIPS)))]
     #[allow(clippy::too_many_arguments)]
     fn build(
         py: Python<'_>,
@@ -209,6 +210,7 @@ impl Environment {
         max_split_depth: u32,
         max_blockers: Option<Bound<'_, PyAny>>,
         blocker_cap: Option<u32>,
+        lift_clips: Option<usize>,
     ) -> PyResult<Environment> {
         let defaults = BuildOptions::default();
         let max_blockers = max_blockers.map(|b| b.str().map(|s| s.to_string())).transpose()?;
@@ -225,7 +227,7 @@ impl Environment {
         };
         let params = o.params(true).map_err(py_err)?;
         let s = scene.inner.clone();
-        let env = py.detach(|| Env::build(&s, params)).map_err(py_err)?;
+        let env = py.detach(|| Env::build(&s, params, lift_clips)).map_err(py_err)?;
         Ok(Environment { inner: Arc::new(env), scene: s })
     }
 

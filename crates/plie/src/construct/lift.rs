@@ -5,12 +5,15 @@
 //! list, regions and grid, as without a cap; one that does not keeps a scene record (with the umbra of
 //! the larger subset). Every answer stays exact either way; only where the scene BVH is walked changes.
 //!
-//! The budget is spent in task order, in batches of up to [`BATCH`] records: each batch's cap is
-//! what the budget left at its start can pay for all of them at the most ([`CANDIDATES_PER_BLOCKER`]
-//! clips per blocker of the cap; the batch shrinks before the cap does), its records are computed in
-//! parallel and committed in order, each paying the candidates it clipped. So the work is bounded by the budget, and the result does not depend on the
-//! thread count. Where few records are capped (an open room) nearly all are lifted; where most are
-//! (dense clutter before a small light) the budget runs out early and the rest keep the cap.
+//! The budget is spent in a fixed order: the records of leaves holding triangles first (shading asks
+//! the records of the leaves its points lie in, and its points lie on triangles; measured against
+//! three other orders in docs/results.md), then by leaf, face and light. It goes in batches of up to
+//! [`BATCH`] records: each batch's cap is what the budget left at its start can pay for all of them
+//! at the most ([`CANDIDATES_PER_BLOCKER`] clips per blocker of the cap; the batch shrinks before the
+//! cap does), its records are computed in parallel and committed in order, each paying the
+//! candidates it clipped. So the work is bounded by the budget, and the result does not depend on
+//! the thread count. Where few records are capped (an open room) nearly all are lifted; where most
+//! are (dense clutter before a small light) the budget runs out early and the rest keep the cap.
 
 use super::blockers::{GatherScratch, CANDIDATES_PER_BLOCKER};
 use super::propagation::{FaceState, Tolerances};
@@ -29,6 +32,7 @@ pub const DEFAULT_LIFT_CLIPS: usize = 16;
 
 /// A lifted cap is at most this many times the blocker cap.
 pub const LIFT_FACTOR: u32 = 16;
+const _: () = assert!(LIFT_FACTOR == 16, "`plie build --help` and `BuildOptions::lift_clips` say 16 times");
 
 /// Most records computed between two looks at the budget.
 pub const BATCH: usize = 64;
@@ -51,7 +55,7 @@ impl Lift {
     }
 }
 
-/// Lifts the cap of `round`'s capped records in task order while `lift`'s budget lasts; the lists'
+/// Lifts the cap of `round`'s capped records in that order while `lift`'s budget lasts; the lists'
 /// bytes stay within `limits.list_bytes`.
 pub(super) fn lift_caps(
     scene: &Scene,
@@ -72,6 +76,9 @@ pub(super) fn lift_caps(
             }
         }
     }
+    // Shading asks the records of the leaves its points lie in: leaves holding triangles first.
+    // (Tasks are numbered leaf by leaf, so the rest is leaf, face, light order.)
+    capped.sort_by_key(|&(t, f)| (octree.leaf_triangles(LeafId((t / lights) as u32)).is_empty(), t, f.index()));
     if capped.is_empty() {
         return Ok(());
     }

@@ -74,7 +74,7 @@ pub struct Limits {
     /// no limit.
     pub list_bytes: Option<usize>,
     /// Candidate clips the construction may spend gathering the records over the blocker cap again
-    /// with a cap up to [`lift::LIFT_FACTOR`] times larger ([`lift`]); in task order, so the result
+    /// with a cap up to [`lift::LIFT_FACTOR`] times larger ([`lift`]); in a fixed order, so the result
     /// does not depend on the thread count. `None`: no lifting (every record over the cap stays a
     /// scene record).
     pub lift_clips: Option<usize>,

@@ -400,9 +400,15 @@ mod tests {
     fn each_phase_prints_its_lines() {
         let mut s = BuildStats::default();
         let text = s.to_string();
-        for start in
-            ["octree ", "data objects ", "blockers ", "scene records ", "regions         none", "refinement      none"]
-        {
+        for start in [
+            "octree ",
+            "data objects ",
+            "blockers ",
+            "scene records ",
+            "lifted cap      none",
+            "regions         none",
+            "refinement      none",
+        ] {
             assert!(text.lines().any(|l| l.starts_with(start)), "{start}: {text}");
         }
         s.regions.regions = true;
