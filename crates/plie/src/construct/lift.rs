@@ -15,6 +15,8 @@
 //! the thread count. Where few records are capped (an open room) nearly all are lifted; where most
 //! are (dense clutter before a small light) the budget runs out early and the rest keep the cap.
 
+use std::sync::Mutex;
+
 use super::blockers::{GatherScratch, CANDIDATES_PER_BLOCKER};
 use super::propagation::{FaceState, Tolerances};
 use super::record::{face_record, FaceOut, PendingRecord};
@@ -87,6 +89,10 @@ pub(super) fn lift_caps(
     let tols = Tolerances::new(tol, abs_scale);
     let mut used: usize =
         round.tasks.iter().flat_map(|t| t.records.iter().flatten()).map(PendingRecord::list_bytes).sum();
+    // One gather scratch per worker thread for all batches (each is a stamp per scene triangle).
+    let scratches: Vec<Mutex<GatherScratch>> = (0..rayon::current_num_threads().max(1))
+        .map(|_| Mutex::new(GatherScratch::new(scene.triangles.len())))
+        .collect();
     progress.start("lifting the blocker cap", capped.len() as u64);
     let max_cap = cap.saturating_mul(LIFT_FACTOR) as usize;
     let mut next = 0;
@@ -107,12 +113,13 @@ pub(super) fn lift_caps(
         }
         let p = PlieParams { blocker_cap: Some(lifted_cap as u32), ..params };
         let task = |t: usize| (LeafId((t / lights) as u32), LightId((t % lights) as u32));
-        schedule::run_ordered_init(
+        schedule::run_ordered(
             batch.len(),
-            || GatherScratch::new(scene.triangles.len()),
-            |scratch, k| {
+            |k| {
                 let (t, face) = batch[k];
-                face_record(scene, octree, task(t), face, &tols, abs_scale, p, scratch)
+                let worker = rayon::current_thread_index().unwrap_or(0) % scratches.len();
+                let mut scratch = scratches[worker].lock().unwrap_or_else(|e| e.into_inner());
+                face_record(scene, octree, task(t), face, &tols, abs_scale, p, &mut scratch)
             },
             |k, fo: FaceOut| {
                 let (t, face) = batch[k];
