@@ -1,9 +1,10 @@
 //! Lifting the blocker cap where the build can afford it (issue 15; SPEC §4.4 with the cap). After
 //! a round, the records the cap turned into [`RecordKind::Scene`] records are gathered again (stages
-//! 2-5, [`face_record`]) with a larger cap, up to [`LIFT_FACTOR`] times the cap, while a budget of
-//! candidate clips lasts ([`Limits::lift_clips`]). A record that fits the larger cap gets its full
-//! list, regions and grid, as without a cap; one that does not keeps a scene record (with the umbra of
-//! the larger subset). Every answer stays exact either way; only where the scene BVH is walked changes.
+//! 2-5, as the round computes them) with a larger cap, up to [`LIFT_FACTOR`] times the cap, while a
+//! budget of candidate clips lasts ([`Limits::lift_clips`]). A record that fits the larger cap gets
+//! its full list, regions and grid, as without a cap; one that does not keeps a scene record (with
+//! the umbra of the larger subset). Every answer stays exact either way; only where the scene BVH
+//! is walked changes.
 //!
 //! The budget is spent in a fixed order: the records of leaves holding triangles first (shading asks
 //! the records of the leaves its points lie in, and its points lie on triangles; measured against
