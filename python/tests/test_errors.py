@@ -71,8 +71,8 @@ def test_environments(scene, tmp_path):
     with pytest.raises(plie.PlieError, match="not a .plie file"):
         plie.Environment.from_bytes(b"junk", scene)
     # Records over the blocker cap get their full lists where the budget allows (`lift_clips`).
-    lifted = plie.Environment.build(scene, blocker_cap=4).stats()
-    capped = plie.Environment.build(scene, blocker_cap=4, lift_clips=None).stats()
+    lifted = plie.Environment.build(scene, blocker_cap=4).stats
+    capped = plie.Environment.build(scene, blocker_cap=4, lift_clips=None).stats
     assert lifted["lift_clips"] == 16 and lifted["records_lifted"] > 0, lifted
     assert capped["lift_clips"] is None and capped["records_lifted"] == 0, capped
     assert capped["records_scene"] > lifted["records_scene"], (capped, lifted)
