@@ -80,22 +80,22 @@ impl std::fmt::Display for BlockerCap {
     }
 }
 
-fn parse_blocker_cap(s: &str) -> std::result::Result<BlockerCap, String> {
+/// A number of `what`, or `none`.
+fn parse_number_or_none(s: &str, what: &str) -> std::result::Result<BlockerCap, String> {
     if s == "none" {
         return Ok(BlockerCap(None));
     }
     s.parse::<u32>()
         .map(|n| BlockerCap(Some(n)))
-        .map_err(|_| format!("expected a number of blockers or `none`, not `{s}`"))
+        .map_err(|_| format!("expected a number of {what} or `none`, not `{s}`"))
+}
+
+fn parse_blocker_cap(s: &str) -> std::result::Result<BlockerCap, String> {
+    parse_number_or_none(s, "blockers")
 }
 
 fn parse_lift_clips(s: &str) -> std::result::Result<BlockerCap, String> {
-    if s == "none" {
-        return Ok(BlockerCap(None));
-    }
-    s.parse::<u32>()
-        .map(|n| BlockerCap(Some(n)))
-        .map_err(|_| format!("expected a number of clips or `none`, not `{s}`"))
+    parse_number_or_none(s, "clips")
 }
 
 /// A value of `--refine`.

@@ -249,11 +249,6 @@ fn the_memory_budget_degrades_records_in_task_order_and_stays_exact() {
     assert!(check_exact(&scene, &tight, 10_000) > 100);
 }
 
-/// The records of `built` by (leaf, face, light).
-fn records_by_face(built: &plie::internals::construct::Built) -> std::collections::HashMap<(u32, usize, u32), usize> {
-    built.plie.records.iter().enumerate().map(|(i, r)| ((r.leaf.0, r.face.index(), r.light.0), i)).collect()
-}
-
 #[test]
 fn lifting_the_cap_gives_records_their_full_lists_and_stays_exact() {
     let scene = balusters();
@@ -268,11 +263,10 @@ fn lifting_the_cap_gives_records_their_full_lists_and_stays_exact() {
     assert!(l.records_lifted > 20 && l.records_scene > 20, "{l:?}");
     assert_eq!(lifted.plie.scene_records(), l.records_scene);
     let max = cap as usize * plie::internals::construct::lift::LIFT_FACTOR as usize;
-    let free_records = records_by_face(&free);
     let (mut same, mut over) = (0, 0);
     for r in &lifted.plie.records {
-        let Some(&fi) = free_records.get(&(r.leaf.0, r.face.index(), r.light.0)) else { continue };
-        let full = free.plie.blockers_of(&free.plie.records[fi]);
+        let Some(theirs) = free.plie.record(r.leaf, r.face, r.light) else { continue };
+        let full = free.plie.blockers_of(theirs);
         if r.kind == RecordKind::Listed {
             // A lifted record holds exactly the list it has without a cap.
             let mut mine = lifted.plie.blockers_of(r).to_vec();

@@ -79,9 +79,10 @@ pub(super) fn lift_caps(
             }
         }
     }
-    // Shading asks the records of the leaves its points lie in: leaves holding triangles first.
-    // (Tasks are numbered leaf by leaf, so the rest is leaf, face, light order.)
-    capped.sort_by_key(|&(t, f)| (octree.leaf_triangles(LeafId((t / lights) as u32)).is_empty(), t, f.index()));
+    let task = |t: usize| (LeafId((t / lights) as u32), LightId((t % lights) as u32));
+    // Shading asks the records of the leaves its points lie in: leaves holding triangles first. The
+    // sort is stable and tasks are numbered leaf by leaf, so the rest stays in leaf, face, light order.
+    capped.sort_by_key(|&(t, _)| octree.leaf_triangles(task(t).0).is_empty());
     if capped.is_empty() {
         return Ok(());
     }
@@ -113,7 +114,6 @@ pub(super) fn lift_caps(
             return Err(Interrupted);
         }
         let p = PlieParams { blocker_cap: Some(lifted_cap as u32), ..params };
-        let task = |t: usize| (LeafId((t / lights) as u32), LightId((t % lights) as u32));
         schedule::run_ordered(
             batch.len(),
             |k| {
