@@ -66,10 +66,12 @@ class Environment:
         max_blockers: Union[int, Literal["adaptive"], None] = None,
         blocker_cap: Optional[int] = 64,
         lift_clips: Optional[int] = 16,
+        cell_clips: Optional[int] = 64,
     ) -> Environment:
         """Builds the octree and the P-LIE; keywords are `plie build`'s options, with its defaults
         (`max_depth` None: the octree's default, 10; `blocker_cap` None: no cap; `lift_clips` None:
-        records over the cap are not gathered again)."""
+        records over the cap are not gathered again; `cell_clips` None: the cells of records still
+        over it are not gathered)."""
     def save(self, path: PathLike) -> int:
         """Writes a `.plie` file atomically; returns its size in bytes."""
     @staticmethod

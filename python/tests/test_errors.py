@@ -78,6 +78,13 @@ def test_environments(scene, tmp_path):
     assert capped["records_scene"] > lifted["records_scene"], (capped, lifted)
     with pytest.raises(OverflowError):
         plie.Environment.build(scene, lift_clips=-1)
+    # The records still over the cap gather their grid cells where a second budget allows.
+    celled = plie.Environment.build(scene, blocker_cap=4, lift_clips=None).stats
+    bare = plie.Environment.build(scene, blocker_cap=4, lift_clips=None, cell_clips=None).stats
+    assert celled["cell_clips"] == 64 and celled["records_scene_cells"] > 0, celled
+    assert bare["cell_clips"] is None and bare["records_scene_cells"] == 0, bare
+    with pytest.raises(OverflowError):
+        plie.Environment.build(scene, cell_clips=-1)
     env = plie.Environment.build(scene)
     good = tmp_path / "good.plie"
     env.save(good)

@@ -52,7 +52,12 @@ pub fn run(a: &Args) -> Result<()> {
     let list_budget = Some(crate::budget::list_bytes(budget, &scene));
     let bar = Bar::new(a.quiet || a.json);
     let t_all = Instant::now();
-    let options = BuildOptions { list_bytes: list_budget, lift_clips: a.params.lift_clips(), progress: &bar };
+    let options = BuildOptions {
+        list_bytes: list_budget,
+        lift_clips: a.params.lift_clips(),
+        cell_clips: a.params.cell_clips(),
+        progress: &bar,
+    };
     let (env, stats) = match Environment::build_with(&scene, &params, options) {
         Err(e @ plie::Error::Interrupted) => {
             return Err(anyhow::Error::new(e).context("P-LIE construction stopped by Ctrl-C; nothing was written"))

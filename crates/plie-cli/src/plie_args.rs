@@ -65,9 +65,16 @@ pub struct PlieArgs {
     /// where most do (dense clutter) the budget bounds the extra time. Exact either way.
     #[arg(long, value_name = "N|none", default_value_t = BlockerCap(Some(plie::DEFAULT_LIFT_CLIPS as u32)), value_parser = parse_lift_clips)]
     pub lift_clips: BlockerCap,
+    /// P-LIE: candidate triangles per scene triangle the build may clip to give the records still
+    /// over the cap (after --lift-clips) face grids of their own (up to 32x32 cells): squares of
+    /// cells, from the face's quarters down, gather their blockers with a cap of 16, and a cell under
+    /// it keeps its list (empty: fully lit) instead of leaving its rays to the scene BVH; spent in a
+    /// fixed order; or `none`. Exact either way.
+    #[arg(long, value_name = "N|none", default_value_t = BlockerCap(Some(plie::DEFAULT_CELL_CLIPS as u32)), value_parser = parse_lift_clips)]
+    pub cell_clips: BlockerCap,
 }
 
-/// A value of `--blocker-cap` or `--lift-clips`: a number, or `None` for `none`.
+/// A value of `--blocker-cap`, `--lift-clips` or `--cell-clips`: a number, or `None` for `none`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct BlockerCap(pub Option<u32>);
 
@@ -140,6 +147,11 @@ impl PlieArgs {
     /// `--lift-clips`: candidate clips per scene triangle ([`BuildOptions::lift_clips`]).
     pub fn lift_clips(&self) -> Option<usize> {
         self.lift_clips.0.map(|n| n as usize)
+    }
+
+    /// `--cell-clips`: candidate clips per scene triangle ([`BuildOptions::cell_clips`]).
+    pub fn cell_clips(&self) -> Option<usize> {
+        self.cell_clips.0.map(|n| n as usize)
     }
 
     /// The refinement asked for.
@@ -279,7 +291,8 @@ pub struct Loaded {
 /// budget, lifting the cap as `args` says.
 pub fn build(scene: &Scene, params: PlieParams, args: &PlieArgs, bar: &Bar) -> Result<Loaded> {
     let list_bytes = Some(crate::budget::list_bytes(crate::budget::default_bytes(), scene));
-    let options = BuildOptions { list_bytes, lift_clips: args.lift_clips(), progress: bar };
+    let options =
+        BuildOptions { list_bytes, lift_clips: args.lift_clips(), cell_clips: args.cell_clips(), progress: bar };
     let (env, stats) = Environment::build_with(scene, &params, options)?;
     crate::budget::warn_over(&stats, bar);
     Ok(Loaded { env, build_seconds: Some(stats.blockers.blockers_seconds), load_seconds: None })

@@ -29,12 +29,18 @@ fn build_json_reports_the_bounds_and_the_budget_degrades_without_aborting() {
     let (v, _) = build_json(&[&base[..], &["--blocker-cap", "24"]].concat());
     assert_eq!(v["lift_clips"], plie::DEFAULT_LIFT_CLIPS);
     assert!(v["records_lifted"].as_u64().unwrap() > 0, "{v}");
+    assert_eq!(v["cell_clips"], plie::DEFAULT_CELL_CLIPS);
     let lifted_scene = v["records_scene"].as_u64().unwrap();
     let (v, _) = build_json(&[&base[..], &["--blocker-cap", "24", "--lift-clips", "none"]].concat());
     assert_eq!(v["blocker_cap"], 24);
     assert!(v["lift_clips"].is_null(), "{v}");
     assert_eq!(v["records_lifted"], 0, "{v}");
     assert!(v["records_scene"].as_u64().unwrap() > lifted_scene, "{v}");
+    // The records over the cap gather their cells (on by default), unless `--cell-clips none`.
+    assert!(v["records_scene_cells"].as_u64().unwrap() > 0 && v["scene_cells_listed"].as_u64().unwrap() > 0, "{v}");
+    let none = ["--blocker-cap", "24", "--lift-clips", "none", "--cell-clips", "none"];
+    let (v, _) = build_json(&[&base[..], &none].concat());
+    assert!(v["cell_clips"].is_null() && v["records_scene_cells"] == 0, "{v}");
     assert_eq!(v["records_over_budget"], 0, "{v}");
     assert!(v["peak_memory_bytes"].as_u64().unwrap() > 1 << 20, "{v}");
     let list = v["list_bytes"].as_u64().unwrap();
@@ -111,6 +117,7 @@ fn bad_bounds_are_one_line_errors() {
     }
     for clips in ["lots", "1e9", "99999999999"] {
         refused(&["--lift-clips", clips], "expected a number of clips or `none`");
+        refused(&["--cell-clips", clips], "expected a number of clips or `none`");
     }
     refused(&["--blocker-cap", "many"], "none");
     fails_with(&["build", "--scene", "balusters-2", "-o", out, "--memory-budget", "1K"], "below");

@@ -177,10 +177,16 @@ pub struct Env {
 
 impl Env {
     /// Builds the octree and the P-LIE (refined if the parameters ask), lifting the blocker cap with
-    /// `lift_clips` clips per scene triangle ([`plie::BuildOptions::lift_clips`]).
-    pub fn build(scene: &LoadedScene, params: PlieParams, lift_clips: Option<usize>) -> Result<Env> {
+    /// `lift_clips` clips per scene triangle ([`plie::BuildOptions::lift_clips`]) and gathering the
+    /// cells of the records still over it with `cell_clips` ([`plie::BuildOptions::cell_clips`]).
+    pub fn build(
+        scene: &LoadedScene,
+        params: PlieParams,
+        lift_clips: Option<usize>,
+        cell_clips: Option<usize>,
+    ) -> Result<Env> {
         let t = Instant::now();
-        let options = plie::BuildOptions { lift_clips, ..Default::default() };
+        let options = plie::BuildOptions { lift_clips, cell_clips, ..Default::default() };
         let (env, stats) = Environment::build_with(&scene.scene, &params, options)?;
         let stats_json = serde_json::to_string(&stats).ok();
         Ok(Env { env, stats_json, seconds: t.elapsed().as_secs_f64() })
@@ -313,8 +319,12 @@ pub fn render(
         Some(e) => renderer.render(&scene.scene, m, Some(&e.env)),
         // A P-LIE mode without an environment builds one with the CLI's defaults, as `plie render`.
         None if m.needs_plie() => {
-            let built =
-                Env::build(scene, BuildOptions::default().params(m == Mode::Grid)?, Some(plie::DEFAULT_LIFT_CLIPS))?;
+            let built = Env::build(
+                scene,
+                BuildOptions::default().params(m == Mode::Grid)?,
+                Some(plie::DEFAULT_LIFT_CLIPS),
+                Some(plie::DEFAULT_CELL_CLIPS),
+            )?;
             renderer.render(&scene.scene, m, Some(&built.env))
         }
         None => {

@@ -196,7 +196,7 @@ impl Environment {
     #[staticmethod]
     #[pyo3(signature = (scene, *, max_triangles=200, max_depth=None, no_grids=false, no_regions=false,
         no_propagation=false, refine=None, max_split_depth=2, max_blockers=None, blocker_cap=Some(64),
-        lift_clips=Some(plie::DEFAULT_LIFT_CLIPS)))]
+        lift_clips=Some(plie::DEFAULT_LIFT_CLIPS), cell_clips=Some(plie::DEFAULT_CELL_CLIPS)))]
     #[allow(clippy::too_many_arguments)]
     fn build(
         py: Python<'_>,
@@ -211,6 +211,7 @@ impl Environment {
         max_blockers: Option<Bound<'_, PyAny>>,
         blocker_cap: Option<u32>,
         lift_clips: Option<usize>,
+        cell_clips: Option<usize>,
     ) -> PyResult<Environment> {
         let defaults = BuildOptions::default();
         let max_blockers = max_blockers.map(|b| b.str().map(|s| s.to_string())).transpose()?;
@@ -227,7 +228,7 @@ impl Environment {
         };
         let params = o.params(true).map_err(py_err)?;
         let s = scene.inner.clone();
-        let env = py.detach(|| Env::build(&s, params, lift_clips)).map_err(py_err)?;
+        let env = py.detach(|| Env::build(&s, params, lift_clips, cell_clips)).map_err(py_err)?;
         Ok(Environment { inner: Arc::new(env), scene: s })
     }
 

@@ -39,13 +39,22 @@ pub struct BuildOptions<'p> {
     /// their full lists anyway, with a cap up to 16 times larger
     /// ([`Limits::lift_clips`]); `None`: records over the cap stay answered by the scene BVH.
     pub lift_clips: Option<usize>,
+    /// Candidate clips per scene triangle the build may spend on the grid cells of the records
+    /// still over the cap after that: each cell under a small cap keeps its full list (empty: fully
+    /// lit) instead of leaving its rays to the scene BVH ([`Limits::cell_clips`]); `None`: none.
+    pub cell_clips: Option<usize>,
     /// Reports progress; [`Progress::cancelled`] stops the build with [`Error::Interrupted`].
     pub progress: &'p dyn Progress,
 }
 
 impl Default for BuildOptions<'_> {
     fn default() -> Self {
-        BuildOptions { list_bytes: None, lift_clips: Some(crate::DEFAULT_LIFT_CLIPS), progress: &NoProgress }
+        BuildOptions {
+            list_bytes: None,
+            lift_clips: Some(crate::DEFAULT_LIFT_CLIPS),
+            cell_clips: Some(crate::DEFAULT_CELL_CLIPS),
+            progress: &NoProgress,
+        }
     }
 }
 
@@ -91,13 +100,15 @@ impl Environment {
         let octree = Octree::build_valid(scene, params.octree());
         let octree_seconds = t.elapsed().as_secs_f64();
         let lift_clips = options.lift_clips.map(|c| c.saturating_mul(scene.triangles.len()));
-        let limits = Limits { list_bytes: options.list_bytes, lift_clips };
+        let cell_clips = options.cell_clips.map(|c| c.saturating_mul(scene.triangles.len()));
+        let limits = Limits { list_bytes: options.list_bytes, lift_clips, cell_clips };
         let built = crate::construct::build_bounded(scene, octree, *params, limits, options.progress)
             .map_err(|_| Error::Interrupted)?;
         let mut stats = built.stats;
         stats.octree.octree_seconds = octree_seconds;
         stats.bounded.list_budget = options.list_bytes;
         stats.bounded.lift_clips = options.lift_clips;
+        stats.bounded.cell_clips = options.cell_clips;
         Ok((Environment::from_parts(scene, built.octree, built.plie), stats))
     }
 

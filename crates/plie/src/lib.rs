@@ -71,6 +71,7 @@ pub(crate) mod render;
 pub(crate) mod verify;
 
 pub use construct::lift::DEFAULT_LIFT_CLIPS;
+pub use construct::scene_cells::DEFAULT_CELL_CLIPS;
 pub use construct::{
     BlockerStats, BoundedStats, BuildStats, GridStats, OctreeStats, PropagationStats, RefinementStats, RegionStats,
     RoundStats,

@@ -186,7 +186,10 @@ fn capped_p_lies_of_the_shared_scenes_are_exact() {
     let mut rng = support::TestRng(0x5ca1e);
     let params = PlieParams { blocker_cap: Some(plie::DEFAULT_BLOCKER_CAP), ..PlieParams::default() };
     for scene in support::load_shared() {
-        let built = build(&scene, params, Limits::default());
+        // The scene records with the default budget of cells (without the lift, so that more
+        // records are scene records).
+        let cells = Some(plie::DEFAULT_CELL_CLIPS * scene.triangles.len());
+        let built = build(&scene, params, Limits { cell_clips: cells, ..Limits::default() });
         let n = if scene.triangles.len() > 100_000 { 2_000 } else { 10_000 };
         let scene_answers = check_exact(&scene, &built, n);
         eprintln!("{}: {scene_answers} of {n} x 4 rays answered by the scene BVH", scene.name);
@@ -236,7 +239,7 @@ fn the_memory_budget_degrades_records_in_task_order_and_stays_exact() {
     let params = PlieParams { blocker_cap: Some(256), ..PlieParams::default() };
     let free = build(&scene, params, Limits::default());
     let budget = free.stats.bounded.list_bytes / 3;
-    let limits = Limits { list_bytes: Some(budget), lift_clips: None };
+    let limits = Limits { list_bytes: Some(budget), ..Limits::default() };
     let tight = build(&scene, params, limits);
     assert!(tight.stats.bounded.records_over_budget > 0);
     assert!(tight.stats.bounded.list_bytes <= budget, "{} > {budget}", tight.stats.bounded.list_bytes);
@@ -303,6 +306,100 @@ fn lifting_spends_at_most_its_budget_in_an_order_free_of_threads() {
     assert!(single.plie == lifted.plie, "the lifted cap's result depends on the thread count");
     let none = build(&scene, params, Limits { lift_clips: Some(0), ..Limits::default() });
     assert!(none.plie == capped.plie, "a budget of nothing lifts nothing");
+}
+
+/// The cells of `built`'s scene records: (record, cell index, cell box on the face, what it says).
+fn scene_cells(built: &plie::internals::construct::Built) -> Vec<(usize, usize, plie::geometry::Aabb, Cell<'_>)> {
+    let p = &built.plie;
+    let mut out = Vec::new();
+    for (ri, r) in p.records.iter().enumerate().filter(|(_, r)| r.kind == RecordKind::Scene) {
+        let g = p.grids[ri];
+        let b = built.octree.leaf_bounds(r.leaf);
+        for c in 0..(g.res * g.res) as usize {
+            let (i, j) = ((c % g.res as usize) as u32, (c / g.res as usize) as u32);
+            out.push((ri, c, cell_box(r.face, &b, g.res, i, j), p.cell(&g, c)));
+        }
+    }
+    out
+}
+
+#[test]
+fn scene_records_cells_hold_every_blocker_of_their_shafts_and_stay_exact() {
+    use plie::internals::construct::blockers::CANDIDATES_PER_BLOCKER;
+    use plie::internals::construct::{grid::SCENE_CELL_CAP, shaft::Shaft, tolerance};
+    let scene = balusters();
+    let params = PlieParams { blocker_cap: Some(8), ..PlieParams::default() };
+    let limits = Limits { cell_clips: Some(usize::MAX / 4), ..Limits::default() };
+    let built = build(&scene, params, limits);
+    let b = &built.stats.bounded;
+    assert_eq!(b.records_scene_cells, b.records_scene, "{b:?}");
+    let tol = tolerance(&scene, &built.octree);
+    let (mut listed, mut lit, mut left) = (0, 0, 0);
+    for (ri, c, cell, what) in scene_cells(&built) {
+        let r = built.plie.records[ri];
+        let light = &scene.lights[r.light.idx()];
+        let shaft = Shaft::new(&r.face.face_corners(&cell), &light.vertices, tol);
+        // Every triangle that meets the cell's shaft (but the light's own), as the record's gather
+        // finds them.
+        let meets: Vec<TriId> = (0..scene.triangles.len())
+            .map(|t| TriId(t as u32))
+            .filter(|t| scene.tri_light[t.idx()] != Some(r.light))
+            .filter(|t| {
+                let tri = &scene.triangles[t.idx()];
+                shaft.bounds.overlaps(&tri.aabb()) && shaft.clips_triangle(&tri.v)
+            })
+            .collect();
+        match what {
+            Cell::Blockers(list) => {
+                assert!(list.len() <= SCENE_CELL_CAP, "record {ri} cell {c}: {} blockers", list.len());
+                assert!(
+                    meets.iter().all(|t| list.contains(t)),
+                    "record {ri} cell {c}: {list:?} misses some of {meets:?}"
+                );
+                listed += 1;
+                lit += list.is_empty() as usize;
+            }
+            // The gather of the cell itself passed its cap: more blockers, or more candidates
+            // (triangles in the shaft's box) than it clips for that many.
+            Cell::Scene => {
+                let boxed = (0..scene.triangles.len())
+                    .filter(|&t| scene.tri_light[t] != Some(r.light))
+                    .filter(|&t| shaft.bounds.overlaps(&scene.triangles[t].aabb()))
+                    .count();
+                assert!(
+                    meets.len() > SCENE_CELL_CAP || boxed >= SCENE_CELL_CAP * CANDIDATES_PER_BLOCKER,
+                    "record {ri} cell {c}: only {} blockers and {boxed} candidates",
+                    meets.len()
+                );
+                left += 1;
+            }
+            Cell::Umbra => {}
+        }
+    }
+    assert!(listed > 100 && lit > 20 && left > 100, "{listed} listed cells ({lit} lit), {left} left to the scene");
+    assert_eq!(listed, b.scene_cells_listed);
+    assert!(check_exact(&scene, &built, 20_000) > 100);
+}
+
+#[test]
+fn scene_cells_spend_at_most_their_budget_in_an_order_free_of_threads() {
+    let scene = balusters();
+    let params = PlieParams { blocker_cap: Some(8), ..PlieParams::default() };
+    let capped = build(&scene, params, Limits::default());
+    let budget = 40 * scene.triangle_count();
+    let limits = Limits { cell_clips: Some(budget), ..Limits::default() };
+    let cells = build(&scene, params, limits);
+    let b = &cells.stats.bounded;
+    // The budget ran out before every scene record had its cells.
+    assert!(b.records_scene_cells > 0 && b.records_scene_cells < b.records_scene, "{b:?}");
+    let spent = cells.stats.blockers.candidates_clipped - capped.stats.blockers.candidates_clipped;
+    assert!(spent <= budget, "{spent} clips spent of a budget of {budget}");
+    let one = rayon::ThreadPoolBuilder::new().num_threads(1).build().unwrap();
+    let single = one.install(|| build(&scene, params, limits));
+    assert!(single.plie == cells.plie, "the scene cells depend on the thread count");
+    let none = build(&scene, params, Limits { cell_clips: Some(0), ..Limits::default() });
+    assert!(none.plie == capped.plie, "a budget of nothing gathers no cells");
+    assert!(check_exact(&scene, &cells, 10_000) > 100);
 }
 
 #[test]

@@ -6,6 +6,7 @@ use std::time::Instant;
 use super::lift::Lift;
 use super::refine::Refiner;
 use super::round::{Round, TaskRecords};
+use super::scene_cells::Cells;
 use super::stats::{BuildStats, RoundStats};
 use super::{grid, Built};
 use crate::lie::{FaceGrid, Plie, PlieParams, Record, RecordKind, RecordRegions, NO_RECORD, SCENE_CELL, UMBRA_CELL};
@@ -22,6 +23,8 @@ pub(super) struct Totals {
     pub(super) unrefined: Option<RoundStats>,
     /// The lifting budget left and what lifting did.
     pub(super) lift: Lift,
+    /// The cell budget left and what it paid for.
+    pub(super) cells: Cells,
 }
 
 impl Totals {
@@ -52,6 +55,7 @@ pub(super) fn finish(
     stats.bounded.blocker_cap = params.blocker_cap;
     stats.bounded.records_over_budget = over_budget;
     (stats.bounded.records_lift_tried, stats.bounded.records_lifted) = (totals.lift.tried, totals.lift.lifted);
+    (stats.bounded.records_scene_cells, stats.bounded.scene_cells_listed) = (totals.cells.records, totals.cells.listed);
     stats.regions.regions = params.has_regions();
     let p = &mut stats.propagation;
     p.enabled = params.propagation == crate::lie::Propagation::On;
@@ -185,7 +189,7 @@ pub(super) fn flatten_grid(grid: Option<grid::PendingGrid>, plie: &mut Plie, sta
         if pg.umbra.get(i).copied().unwrap_or(false) {
             stats.grids.grid_cells_umbra += 1;
             plie.cells.push(UMBRA_CELL);
-        } else if pg.scene {
+        } else if pg.scene && pg.cell_list.get(i).is_none_or(|&l| l == grid::SCENE_LIST) {
             plie.cells.push(SCENE_CELL);
         } else {
             let r = ranges[pg.cell_list[i] as usize];

@@ -11,13 +11,14 @@
 
 use glam::DVec2;
 
+use super::blockers::{gather_blockers, GatherScratch, CANDIDATES_PER_BLOCKER};
 use super::regions::FaceRegions;
 use super::shaft::Shaft;
 use crate::geometry::Aabb;
 use crate::lie::frame::UNITS;
 pub use crate::lie::grid::{cell_box, cell_of};
-use crate::octree::Dir;
-use crate::scene::{Light, Scene, TriId};
+use crate::octree::{Dir, Octree};
+use crate::scene::{Light, LightId, Scene, TriId};
 
 /// Records with fewer blockers than this keep no grid: their list is short already (unless they have
 /// umbra to classify).
@@ -45,9 +46,75 @@ pub struct PendingGrid {
     pub cell_list: Vec<u32>,
     /// Cells fully in umbra (empty until the regions have classified them).
     pub umbra: Vec<bool>,
-    /// The grid of a [`crate::lie::RecordKind::Scene`] record: no lists; the cells not in umbra are
-    /// answered by the scene BVH.
+    /// The grid of a [`crate::lie::RecordKind::Scene`] record: the cells not in umbra whose list
+    /// is [`SCENE_LIST`] (all of them when `cell_list` is empty) are answered by the scene BVH.
     pub scene: bool,
+}
+
+/// `cell_list` entry of a cell of a scene record's grid whose own gather passed its cap: the scene
+/// BVH answers rays through it.
+pub const SCENE_LIST: u32 = u32::MAX;
+
+/// Most blockers of a square of cells of a [`crate::lie::RecordKind::Scene`] record's grid for it to
+/// keep its list ([`scene_cells`]).
+pub const SCENE_CELL_CAP: usize = 16;
+
+/// Most candidate clips [`scene_cells`] spends on a grid of `g x g` cells (`g` a power of two, at
+/// least 2): at most `(4 g^2 - 4) / 3` squares gather ([`CANDIDATES_PER_BLOCKER`] clips per blocker of
+/// [`SCENE_CELL_CAP`] each) and at most as many filter a list of at most [`SCENE_CELL_CAP`].
+pub const fn scene_cells_clips(g: u32) -> usize {
+    let squares = (4 * (g as usize) * (g as usize) - 4) / 3;
+    squares * (CANDIDATES_PER_BLOCKER * SCENE_CELL_CAP + SCENE_CELL_CAP)
+}
+
+/// The cells of a [`crate::lie::RecordKind::Scene`] record's `g x g` grid (issue 15; `g` a power of
+/// two, at least 2), as a quadtree from the face's four quarters down: a square of cells not all in
+/// the umbra (`umbra`, empty for none) gathers the blockers of the shaft from it to the light
+/// ([`gather_blockers`], as the record's own gather does) with a cap of [`SCENE_CELL_CAP`]. Under the
+/// cap, its cells get their lists from that one as a listed record's grid does ([`face_grid`]'s
+/// filtering); over it, its quarters try in turn, and a single cell over it is left to the scene
+/// BVH ([`SCENE_LIST`]). Every list is a cell's full list, so every answer stays exact. Returns the
+/// grid and the candidates clipped (gathered and filtered), at most [`scene_cells_clips`].
+#[allow(clippy::too_many_arguments)]
+pub fn scene_cells(
+    scene: &Scene,
+    octree: &Octree,
+    (face, cell): (Dir, &Aabb),
+    (light, light_id): (&Light, LightId),
+    tol: f32,
+    g: u32,
+    umbra: Vec<bool>,
+    scratch: &mut GatherScratch,
+) -> (PendingGrid, usize) {
+    debug_assert!(g >= 2 && g.is_power_of_two());
+    let mut out =
+        PendingGrid { g, lists: Vec::new(), cell_list: vec![SCENE_LIST; (g * g) as usize], umbra, scene: true };
+    let quad = Quad { scene, face, cell, light, tol, g, clipped: std::cell::Cell::new(0) };
+    let mut gathered = 0;
+    let mut list = Vec::new();
+    let mut todo = vec![(0, 0, g / 2), (g / 2, 0, g / 2), (0, g / 2, g / 2), (g / 2, g / 2, g / 2)];
+    while let Some((i, j, size)) = todo.pop() {
+        let in_umbra = |c: u32, r: u32| out.umbra.get((r * g + c) as usize).copied().unwrap_or(false);
+        if (j..j + size).all(|r| (i..i + size).all(|c| in_umbra(c, r))) {
+            continue;
+        }
+        let corners = face.face_corners(&quad.square(i, j, size));
+        let shaft = Shaft::new(&corners, &light.vertices, tol);
+        list.clear();
+        let got = gather_blockers(scene, octree, &shaft, light_id, Some(SCENE_CELL_CAP), scratch, &mut list);
+        gathered += got.candidates;
+        if !got.capped {
+            if size == 1 {
+                quad.share(i, j, 1, list.clone(), &mut out);
+            } else {
+                quad.split(i, j, size, &list, &mut out);
+            }
+        } else if size > 1 {
+            let h = size / 2;
+            todo.extend([(i, j, h), (i + h, j, h), (i, j + h, h), (i + h, j + h, h)]);
+        }
+    }
+    (out, gathered + quad.clipped.get())
 }
 
 /// A square is split into four only if the four lists together hold at most this many times the
@@ -79,7 +146,7 @@ pub fn face_grid(
         umbra: Vec::new(),
         scene: false,
     };
-    let quad = Quad { scene, face, cell, light, tol, g };
+    let quad = Quad { scene, face, cell, light, tol, g, clipped: std::cell::Cell::new(0) };
     quad.split(0, 0, g, blockers, &mut out);
     debug_assert!(out.cell_list.iter().all(|&c| (c as usize) < out.lists.len()));
     Some(out)
@@ -94,15 +161,23 @@ struct Quad<'a> {
     light: &'a Light,
     tol: f32,
     g: u32,
+    /// Blockers filtered so far (each one clip).
+    clipped: std::cell::Cell<usize>,
 }
 
 impl Quad<'_> {
-    /// The blockers of `parent` that meet the shaft from the square of `size` cells at `(i, j)`.
-    fn filter(&self, i: u32, j: u32, size: u32, parent: &[TriId]) -> Vec<TriId> {
+    /// The face rectangle of the square of `size` cells at `(i, j)`.
+    fn square(&self, i: u32, j: u32, size: u32) -> Aabb {
         let lo = cell_box(self.face, self.cell, self.g, i, j);
         let hi = cell_box(self.face, self.cell, self.g, i + size - 1, j + size - 1);
-        let corners = self.face.face_corners(&lo.union(hi));
+        lo.union(hi)
+    }
+
+    /// The blockers of `parent` that meet the shaft from the square of `size` cells at `(i, j)`.
+    fn filter(&self, i: u32, j: u32, size: u32, parent: &[TriId]) -> Vec<TriId> {
+        let corners = self.face.face_corners(&self.square(i, j, size));
         let shaft = Shaft::new(&corners, &self.light.vertices, self.tol);
+        self.clipped.set(self.clipped.get() + parent.len());
         parent
             .iter()
             .copied()

@@ -5,7 +5,8 @@
 //! 2. [`shaft`]: bounding volume and supporting planes of conv(face ∪ light) (§4.2, §4.3).
 //! 3. [`blockers`]: gather candidates from the overlapping leaves, de-duplicate, clip (§4.4). With a
 //!    blocker cap (issue 15), [`lift`] gathers the records over it again after the round with a
-//!    larger cap, while a budget of clips lasts.
+//!    larger cap, while a budget of clips lasts, and [`scene_cells`] gathers the cells of those
+//!    still over it with a small cap, while a second budget lasts.
 //! 4. [`regions`]: umbra and penumbra on the face (§4.5); a record fully in umbra is removed (§4.6).
 //! 5. [`grid`]: per record, a face grid of per-cell blocker lists with its umbra cells marked (our
 //!    addition, SPEC §8 points 2-4).
@@ -31,6 +32,7 @@ mod record;
 pub mod refine;
 pub mod regions;
 mod round;
+pub mod scene_cells;
 pub mod schedule;
 pub mod shaft;
 mod stats;
@@ -45,6 +47,7 @@ use lift::{lift_caps, Lift};
 use propagation::Propagated;
 use refine::Refiner;
 use round::{run_round, Prior};
+use scene_cells::{gather_scene_cells, Cells};
 pub use stats::{
     BlockerStats, BoundedStats, BuildStats, GridStats, OctreeStats, PropagationStats, RefinementStats, RegionStats,
     RoundStats,
@@ -78,6 +81,11 @@ pub struct Limits {
     /// does not depend on the thread count. `None`: no lifting (every record over the cap stays a
     /// scene record).
     pub lift_clips: Option<usize>,
+    /// Candidate clips the construction may spend gathering the cells of the records still over the
+    /// cap after the lift, each cell with a small cap ([`scene_cells`]); in a fixed order, so the
+    /// result does not depend on the thread count. `None`: none (their cells outside the umbra stay
+    /// answered by the scene BVH).
+    pub cell_clips: Option<usize>,
 }
 
 /// The construction was interrupted ([`Progress::cancelled`]); nothing was built.
@@ -121,11 +129,13 @@ pub fn build_bounded(
     let mut refiner = Refiner::new(&octree);
     let mut totals = flatten::Totals::default();
     totals.lift = Lift::new(&limits);
+    totals.cells = Cells::new(&limits);
     let mut prior = None;
     let round = loop {
         // Stages 1-6 for every (leaf, light), but those of leaves the last round did not split.
         let mut round = run_round(scene, &octree, params, limits, progress, &refiner.stage(), prior.take())?;
         lift_caps(scene, &octree, params, &limits, progress, &mut round, &mut totals.lift)?;
+        gather_scene_cells(scene, &octree, params, &limits, progress, &mut round, &mut totals.cells)?;
         totals.add(&round);
         if !params.refine.enabled() {
             break round;

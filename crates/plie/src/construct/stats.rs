@@ -84,6 +84,13 @@ pub struct BoundedStats {
     pub records_lift_tried: usize,
     /// Of those, the records that fit it: they hold their full lists (or were removed in umbra).
     pub records_lifted: usize,
+    /// Candidate clips the construction could spend on the cells of the records still over the cap
+    /// ([`crate::BuildOptions::cell_clips`], per scene triangle); `None`: none.
+    pub cell_clips: Option<usize>,
+    /// Records over the cap whose grid cells gathered their own blockers (`construct::scene_cells`).
+    pub records_scene_cells: usize,
+    /// Of their cells, those under the cells' cap: they hold their full lists (empty: fully lit).
+    pub scene_cells_listed: usize,
     /// Bytes of the blocker lists stored (records and grid cells).
     pub list_bytes: usize,
 }
@@ -240,6 +247,14 @@ impl fmt::Display for BoundedStats {
                 "lifted cap      {} of {} records over the cap gathered again hold their full lists ({b} clips per triangle)",
                 self.records_lifted, self.records_lift_tried
             ),
+        }?;
+        match self.cell_clips {
+            None => writeln!(f, "scene cells     none"),
+            Some(b) => writeln!(
+                f,
+                "scene cells     {} records over the cap gathered their cells: {} cells hold their full lists ({b} clips per triangle)",
+                self.records_scene_cells, self.scene_cells_listed
+            ),
         }
     }
 }
@@ -379,6 +394,8 @@ mod tests {
             "records_scene",
             "records_over_budget",
             "records_lifted",
+            "records_scene_cells",
+            "scene_cells_listed",
             "list_bytes",
             "regions",
             "records_removed_umbra",
@@ -406,6 +423,7 @@ mod tests {
             "blockers ",
             "scene records ",
             "lifted cap      none",
+            "scene cells     none",
             "regions         none",
             "refinement      none",
         ] {
