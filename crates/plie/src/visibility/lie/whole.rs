@@ -54,7 +54,7 @@ pub(super) enum Whole {
     /// empty lists): only the leaf's own triangles remain to test.
     Lit,
     /// Every footprint lies in cells (or on records without a grid) whose distinct lists hold at
-    /// most [`GATHER_MAX`] triangles in all, and their keys are gathered: each sample's own list is
+    /// most [`gather_max`] triangles in all, and their keys are gathered: each sample's own list is
     /// one of them, so testing every sample against all of them (and the leaf's own triangles) finds
     /// exactly its blockers.
     Lists,
@@ -78,8 +78,9 @@ impl LieVisibility<'_> {
         // `umbra`: every footprint so far lies in umbra cells or on a face without a record (the
         // samples' rays must also all leave the leaf).
         let (mut lit, mut umbra, mut listed) = (true, true, self.mode == Mode::Grid);
-        // Triangles in the distinct lists gathered so far.
+        // Triangles in the distinct lists gathered so far, and how many may be.
         let mut gathered = 0;
+        let max = gather_max(rays.targets.len());
         // Each footprint as it is found; once none of the verdicts can hold, the rest are not
         // computed.
         let all_exit = footprints(bounds, rays.origin, poly, SEGMENT_EPS, |fp| {
@@ -110,7 +111,7 @@ impl LieVisibility<'_> {
                     umbra &= count(1) == 0;
                     listed &= count(2) == 0;
                     if listed && count(0) > 0 {
-                        listed = self.gather_cells(ri, g, (i0, i1), (j0, j1), &mut gathered, sc);
+                        listed = self.gather_cells(ri, g, (i0, i1), (j0, j1), (&mut gathered, max), sc);
                     }
                 }
                 None => {
@@ -119,7 +120,7 @@ impl LieVisibility<'_> {
                     umbra = false;
                     if listed && !empty {
                         gathered += record.blockers_len as usize;
-                        listed = record.kind == RecordKind::Listed && gathered <= GATHER_MAX;
+                        listed = record.kind == RecordKind::Listed && gathered <= max;
                         sc.lists.push(ri as u32);
                     }
                 }
@@ -143,14 +144,14 @@ impl LieVisibility<'_> {
 
     /// Adds the distinct non-empty lists of the cells `[i0, i1] x [j0, j1]` of record `ri`'s grid
     /// (`g` cells a side, none of them umbra or scene) to `sc.lists`, and their lengths to
-    /// `gathered`; false once that exceeds [`GATHER_MAX`].
+    /// `gathered`; false once that exceeds `max` ([`gather_max`]).
     fn gather_cells(
         &self,
         ri: usize,
         g: usize,
         (i0, i1): (usize, usize),
         (j0, j1): (usize, usize),
-        gathered: &mut usize,
+        (gathered, max): (&mut usize, usize),
         sc: &mut LightScratch,
     ) -> bool {
         let first = self.plie.grids[ri].cells_start as usize;
@@ -162,7 +163,7 @@ impl LieVisibility<'_> {
                     continue;
                 }
                 *gathered += range.1 as usize;
-                if *gathered > GATHER_MAX {
+                if *gathered > max {
                     return false;
                 }
                 sc.ranges.push(range);
@@ -173,12 +174,19 @@ impl LieVisibility<'_> {
     }
 }
 
-/// Most triangles, in all, of the distinct lists a light's footprints gather ([`Whole::Lists`]); a
-/// light over more is answered by the scene BVH. Measured (callgrind of the query at 64 rays on
-/// cornell-cube-2, huis-c, dragon, cornell-bunny and conference-lit, docs/results.md session 8): 32
-/// needed the fewest instructions in all of 16, 32, 64, 256 and 1024. Once the walk got cheaper
-/// (session 13), 16 needed 1.3% fewer than 32 over eight scenes and ray counts.
-pub(super) const GATHER_MAX: usize = 16;
+/// Most triangles, in all, of the distinct lists the footprints of a light of `samples` samples
+/// gather ([`Whole::Lists`]): a quarter of the samples, from 4 to 16; a light over more is answered
+/// by the scene BVH. The gathered lists cost a test per triangle and sample, the walk far less per
+/// sample, so the fewer the samples the shorter the lists that pay. Measured (callgrind of the query
+/// on conference-lit, cornell-dragon-100k, cornell-bunny and huis-c, docs/results.md issue 21
+/// session 19), in all four scenes' instructions: at 16 samples 4 needed 1.4% fewer than 16 (8:
+/// 1.0%), at 32 samples 8 needed 0.3% fewer than 16, at 64 samples 32 needed 0.03% fewer (but 0.5%
+/// more on huis-c) and 48 or 64 more.
+/// (Sessions 8 and 13 chose one limit for every sample count: 32, then 16.)
+#[inline]
+pub(super) fn gather_max(samples: usize) -> usize {
+    (samples / 4).clamp(4, 16)
+}
 
 /// A blocker list key of a per-light query: a record's index, or a face-grid cell's index with the
 /// top bit set.
