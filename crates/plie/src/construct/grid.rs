@@ -51,6 +51,13 @@ pub struct PendingGrid {
     pub scene: bool,
 }
 
+impl PendingGrid {
+    /// Bytes its distinct lists will take in the P-LIE.
+    pub fn list_bytes(&self) -> usize {
+        self.lists.iter().map(Vec::len).sum::<usize>() * std::mem::size_of::<TriId>()
+    }
+}
+
 /// `cell_list` entry of a cell of a scene record's grid whose own gather passed its cap: the scene
 /// BVH answers rays through it.
 pub const SCENE_LIST: u32 = u32::MAX;

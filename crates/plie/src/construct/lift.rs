@@ -21,7 +21,7 @@ use std::sync::Mutex;
 use super::blockers::{GatherScratch, CANDIDATES_PER_BLOCKER};
 use super::propagation::{FaceState, Tolerances};
 use super::record::{face_record, FaceOut, PendingRecord};
-use super::round::Round;
+use super::round::{list_bytes, Round};
 use super::{abs_scale, schedule, tolerance, Interrupted, Limits};
 use crate::lie::{PlieParams, RecordKind};
 use crate::octree::{Dir, LeafId, Octree};
@@ -71,30 +71,16 @@ pub(super) fn lift_caps(
 ) -> Result<(), Interrupted> {
     let (Some(cap), Some(_)) = (params.blocker_cap, lift.clips_left) else { return Ok(()) };
     let lights = scene.lights.len();
-    let mut capped: Vec<(usize, Dir)> = Vec::new();
-    for (t, task) in round.tasks.iter().enumerate() {
-        for f in Dir::ALL {
-            if task.records[f.index()].as_ref().is_some_and(|r| r.liftable) {
-                capped.push((t, f));
-            }
-        }
-    }
-    let task = |t: usize| (LeafId((t / lights) as u32), LightId((t % lights) as u32));
-    // Shading asks the records of the leaves its points lie in: leaves holding triangles first. The
-    // sort is stable and tasks are numbered leaf by leaf, so the rest stays in leaf, face, light order.
-    capped.sort_by_key(|&(t, _)| octree.leaf_triangles(task(t).0).is_empty());
+    let capped = in_lift_order(round, octree, lights, |r| r.liftable);
+    let task = |t: usize| task_of(t, lights);
     if capped.is_empty() {
         return Ok(());
     }
     let tol = tolerance(scene, octree);
     let abs_scale = abs_scale(octree);
     let tols = Tolerances::new(tol, abs_scale);
-    let mut used: usize =
-        round.tasks.iter().flat_map(|t| t.records.iter().flatten()).map(PendingRecord::list_bytes).sum();
-    // One gather scratch per worker thread for all batches (each is a stamp per scene triangle).
-    let scratches: Vec<Mutex<GatherScratch>> = (0..rayon::current_num_threads().max(1))
-        .map(|_| Mutex::new(GatherScratch::new(scene.triangles.len())))
-        .collect();
+    let mut used = list_bytes(&round.tasks);
+    let scratches = worker_scratches(scene);
     progress.start("lifting the blocker cap", capped.len() as u64);
     let max_cap = cap.saturating_mul(LIFT_FACTOR) as usize;
     let mut next = 0;
@@ -163,4 +149,37 @@ pub(super) fn lift_caps(
     }
     progress.finish();
     Ok(())
+}
+
+/// The records of `round` that `keep` accepts, as (task, face), in the lift's order: shading asks the
+/// records of the leaves its points lie in, so leaves holding triangles first. The sort is stable and
+/// tasks are numbered leaf by leaf, so the rest stays in leaf, face, light order. (The cells of
+/// [`super::scene_cells`] follow it too.)
+pub(super) fn in_lift_order(
+    round: &Round,
+    octree: &Octree,
+    lights: usize,
+    keep: impl Fn(&PendingRecord) -> bool,
+) -> Vec<(usize, Dir)> {
+    let mut out: Vec<(usize, Dir)> = Vec::new();
+    for (t, task) in round.tasks.iter().enumerate() {
+        for f in Dir::ALL {
+            if task.records[f.index()].as_ref().is_some_and(&keep) {
+                out.push((t, f));
+            }
+        }
+    }
+    out.sort_by_key(|&(t, _)| octree.leaf_triangles(task_of(t, lights).0).is_empty());
+    out
+}
+
+/// The (leaf, light) of task `t` of a round over `lights` lights.
+pub(super) fn task_of(t: usize, lights: usize) -> (LeafId, LightId) {
+    (LeafId((t / lights) as u32), LightId((t % lights) as u32))
+}
+
+/// One gather scratch per worker thread, for all batches of a pass (each is a stamp per scene
+/// triangle).
+pub(super) fn worker_scratches(scene: &Scene) -> Vec<Mutex<GatherScratch>> {
+    (0..rayon::current_num_threads().max(1)).map(|_| Mutex::new(GatherScratch::new(scene.triangles.len()))).collect()
 }

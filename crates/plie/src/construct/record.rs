@@ -43,8 +43,7 @@ impl PendingRecord {
 
     /// Bytes its blocker lists (record and grid cells) will take in the P-LIE.
     pub(super) fn list_bytes(&self) -> usize {
-        let cells: usize = self.grid.iter().flat_map(|g| &g.lists).map(Vec::len).sum();
-        (self.blockers.len() + cells) * std::mem::size_of::<TriId>()
+        self.blockers.len() * std::mem::size_of::<TriId>() + self.grid.as_ref().map_or(0, grid::PendingGrid::list_bytes)
     }
 
     /// Turns a listed record into a [`RecordKind::Scene`] one (over the memory budget).

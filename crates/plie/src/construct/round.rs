@@ -52,6 +52,12 @@ impl Round {
     }
 }
 
+/// Bytes the blocker lists of `tasks`' records take ([`PendingRecord::list_bytes`]): what the memory
+/// budget has spent on them.
+pub(super) fn list_bytes(tasks: &[TaskRecords]) -> usize {
+    tasks.iter().flat_map(|t| t.records.iter().flatten()).map(PendingRecord::list_bytes).sum()
+}
+
 /// The previous round and, for each leaf of the refined octree, the leaf of the previous one it is
 /// (`None` for a new child).
 pub(super) struct Prior {
@@ -103,7 +109,7 @@ pub(super) fn run_round(
     // and its result discarded at its own commit).
     let deleted: Vec<AtomicBool> = (0..states.len()).map(|_| AtomicBool::new(false)).collect();
     // The budget counts the lists of the records carried over from the previous round too.
-    let used = tasks.iter().flat_map(|t| t.records.iter().flatten()).map(PendingRecord::list_bytes).sum();
+    let used = list_bytes(&tasks);
     let budget = Budget { limit: limits.list_bytes, used, over: 0, grids: params.has_grids() };
     let mut commits = Commits { states, propagator, tasks, lights, propagate, seconds: 0.0, wasted: 0, budget };
     let cancelled = AtomicBool::new(false);

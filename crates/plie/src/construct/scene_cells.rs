@@ -17,17 +17,13 @@
 //! (docs/results.md, issue 15): finer grids recover more of the uncapped shading per clip, and the
 //! first few hundred records in that order recover nearly all of it.
 
-use std::sync::Mutex;
-
-use super::blockers::GatherScratch;
-use super::lift::BATCH;
-use super::record::PendingRecord;
-use super::round::Round;
+use super::lift::{in_lift_order, task_of, worker_scratches, BATCH};
+use super::round::{list_bytes, Round};
 use super::{grid, tolerance, Interrupted, Limits};
 use crate::lie::{PlieParams, RecordKind};
-use crate::octree::{Dir, LeafId, Octree};
+use crate::octree::{Dir, Octree};
 use crate::progress::Progress;
-use crate::scene::{LightId, Scene};
+use crate::scene::Scene;
 
 /// The cell budget `plie build`, `render`, `bench` and [`crate::BuildOptions::default`] use:
 /// candidate clips per scene triangle ([`crate::BuildOptions::cell_clips`]); chosen by the
@@ -75,29 +71,16 @@ pub(super) fn gather_scene_cells(
         return Ok(());
     }
     let lights = scene.lights.len();
-    let mut todo: Vec<(usize, Dir)> = Vec::new();
-    for (t, task) in round.tasks.iter().enumerate() {
-        for f in Dir::ALL {
-            let needs = |r: &PendingRecord| {
-                r.kind == RecordKind::Scene && r.grid.as_ref().is_none_or(|g| g.cell_list.is_empty())
-            };
-            if task.records[f.index()].as_ref().is_some_and(needs) {
-                todo.push((t, f));
-            }
-        }
-    }
-    let task = |t: usize| (LeafId((t / lights) as u32), LightId((t % lights) as u32));
-    // The lift's order: leaves holding triangles first, the rest in leaf, face, light order.
-    todo.sort_by_key(|&(t, _)| octree.leaf_triangles(task(t).0).is_empty());
+    let todo = in_lift_order(round, octree, lights, |r| {
+        r.kind == RecordKind::Scene && r.grid.as_ref().is_none_or(|g| g.cell_list.is_empty())
+    });
+    let task = |t: usize| task_of(t, lights);
     if todo.is_empty() {
         return Ok(());
     }
     let tol = tolerance(scene, octree);
-    let mut used: usize =
-        round.tasks.iter().flat_map(|t| t.records.iter().flatten()).map(PendingRecord::list_bytes).sum();
-    let scratches: Vec<Mutex<GatherScratch>> = (0..rayon::current_num_threads().max(1))
-        .map(|_| Mutex::new(GatherScratch::new(scene.triangles.len())))
-        .collect();
+    let mut used = list_bytes(&round.tasks);
+    let scratches = worker_scratches(scene);
     progress.start("cells of the records over the cap", todo.len() as u64);
     let mut next = 0;
     // Records committed since the last one with a cell under the cap.
@@ -143,8 +126,7 @@ pub(super) fn gather_scene_cells(
                 *left = left.saturating_sub(clipped);
                 let slot = &mut round.tasks[t];
                 slot.candidates += clipped;
-                let bytes: usize =
-                    grid.lists.iter().map(Vec::len).sum::<usize>() * std::mem::size_of::<crate::scene::TriId>();
+                let bytes = grid.list_bytes();
                 if limits.list_bytes.is_none_or(|l| used + bytes <= l) {
                     used += bytes;
                     cells.records += 1;
