@@ -2,7 +2,7 @@
 """Tables for docs/results.md (issue 15): time, peak memory and file size of `plie build` (default
 options) per scene, before and after the blocker cap, and for several caps.
 
-Usage: scripts/bounded_table.py --binary target/release/plie [--before PATH] [--caps 1024,none]
+Usage: scripts/bounded_table.py --binary target/release/plie [--before PATH] [--caps default,1024,none]
        [--scenes A,B] [--shared DIR] [--timeout S] [--threads T] [--repeat N] [--before-label L]
 Each build runs under `/usr/bin/time -v` (peak RSS, CPU time of the whole process) with a timeout,
 `--repeat N` times interleaved with the other binaries' (the row shows the run with the median
@@ -86,7 +86,9 @@ def main():
             runs = []
             if a.before:
                 runs.append((a.before_label, a.before, None))
-            runs += [(f"cap {c}", a.binary, c) for c in a.caps.split(",")]
+            # `default`: the binary's default options (no --blocker-cap).
+            runs += [("default" if c == "default" else f"cap {c}", a.binary, None if c == "default" else c)
+                     for c in a.caps.split(",")]
             results = [[] for _ in runs]
             for _ in range(a.repeat):
                 for k, (label, binary, cap) in enumerate(runs):

@@ -64,20 +64,24 @@ pub(super) enum Whole {
 
 impl LieVisibility<'_> {
     /// The samples of the light polygon `poly` (the light of `rays` or a part of it) at once, from
-    /// its footprints on the faces of `leaf` ([`footprints`]), if they decide them ([`Whole`]). For
-    /// [`Whole::Lists`], the keys of the lists (see [`CELL_KEY`]) are added to `sc.lists`, each
-    /// distinct list once (other outcomes may have added some too).
+    /// its footprints on the faces of `leaf` ([`footprints`]), if they decide them ([`Whole`]); with
+    /// `only_umbra`, [`Whole::Umbra`] or [`Whole::Mixed`] only. For [`Whole::Lists`], the keys of
+    /// the lists (see [`CELL_KEY`]) are added to `sc.lists`, each distinct list once (other outcomes
+    /// may have added some too).
     pub(super) fn whole_light(
         &self,
         leaf: LeafId,
         bounds: &Aabb,
         rays: &LightRays,
         poly: &[Vec3],
+        only_umbra: bool,
         sc: &mut LightScratch,
     ) -> Whole {
         // `umbra`: every footprint so far lies in umbra cells or on a face without a record (the
-        // samples' rays must also all leave the leaf).
-        let (mut lit, mut umbra, mut listed) = (true, true, self.mode == Mode::Grid);
+        // samples' rays must also all leave the leaf). With `only_umbra` (a leaf whose lit and
+        // listed lights go to the scene BVH anyway), the other two verdicts are not sought: the
+        // footprints stop at the first that is not in umbra, and no list is gathered.
+        let (mut lit, mut umbra, mut listed) = (!only_umbra, true, self.mode == Mode::Grid && !only_umbra);
         // Triangles in the distinct lists gathered so far, and how many may be.
         let mut gathered = 0;
         let max = gather_max(rays.targets.len());
