@@ -87,7 +87,7 @@ def main():
             if a.before:
                 runs.append((a.before_label, a.before, None))
             # `default`: the binary's default options (no --blocker-cap).
-            runs += [("default" if c == "default" else f"cap {c}", a.binary, None if c == "default" else c)
+            runs += [("default", a.binary, None) if c == "default" else (f"cap {c}", a.binary, c)
                      for c in a.caps.split(",")]
             results = [[] for _ in runs]
             for _ in range(a.repeat):

@@ -68,7 +68,8 @@ impl LieVisibility<'_> {
             sc.ranges.clear();
             ctx.stats.lights.queries += 1;
             // A leaf with many triangles of its own: the BVH culls them better than the fan does,
-            // so only umbra can spare its lights the walk, and the footprints look for nothing else.
+            // so only umbra can spare its lights the walk, and the footprints look for nothing else
+            // (its lights come back as umbra or mixed, never lit or listed).
             let crowded = self.own[leaf.idx()].1 as usize > OWN_MAX;
             match self.whole_light(leaf, &bounds, rays, &self.scene.lights[rays.light.idx()].vertices, crowded, sc) {
                 Whole::Umbra => {
@@ -76,7 +77,6 @@ impl LieVisibility<'_> {
                     ctx.stats.lights.whole_umbra += 1;
                     ctx.stats.answers.count_n(Answer::Umbra, out.len());
                 }
-                Whole::Lit | Whole::Lists if crowded => self.by_scene(leaf, rays, sc, out, ctx),
                 Whole::Lit => self.own_only(leaf, rays, sc, out, ctx),
                 Whole::Lists => self.lists_only(leaf, rays, sc, out, ctx),
                 Whole::Mixed => self.by_scene(leaf, rays, sc, out, ctx),
