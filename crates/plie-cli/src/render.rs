@@ -311,6 +311,7 @@ fn print_answers(s: &QueryStats) {
             ("whole umbra", l.whole_umbra),
             ("whole lit", l.whole_lit),
             ("gathered", l.gathered),
+            ("shaft", l.shaft),
             ("scene BVH", l.scene),
         ] {
             eprintln!("  {name:<14} {n:>12} {:>6.1}%", share(n));

@@ -103,6 +103,9 @@ fn per_light_answers_equal_per_ray_and_brute_force_on_shared_scenes() {
         // Brute force over 100k triangles is slow: fewer queries on the large scenes.
         let n = if scene.triangles.len() > 10_000 { 40 } else { 300 };
         check(&scene, &built, &queries(&scene, &built, n, 22));
+        // And points crowded on pieces, whose lights get answered from their shafts.
+        let (clusters, per) = if scene.triangles.len() > 10_000 { (4, 40) } else { (12, 60) };
+        check(&scene, &built, &clustered_queries(&scene, &built, clusters, per, 27));
     }
 }
 
@@ -152,6 +155,54 @@ fn per_light_answers_on_a_refined_p_lie() {
     let params = PlieParams { refine, ..PlieParams::thesis() };
     let built = Built::refined(&scene, params);
     check(&scene, &built, &queries(&scene, &built, 300, 23));
+}
+
+/// Many points on the same few pieces of triangles (a triangle's part in one leaf), as a render
+/// asks them: the P-LIE modes answer such pieces' lights from the triangles of their shafts once a
+/// piece has been asked often enough (`lie::shafts`), and still as per ray and as brute force.
+fn clustered_queries(scene: &Scene, built: &Built, clusters: usize, per: usize, seed: u64) -> Vec<Query> {
+    let mut rng = TestRng(seed);
+    let mut out = Vec::with_capacity(clusters * per);
+    let mut made = 0;
+    while made < clusters {
+        let t = rng.below(scene.triangles.len());
+        let li = rng.below(scene.lights.len());
+        let light = &scene.lights[li];
+        let tri = &scene.triangles[t];
+        if scene.tri_light[t].is_some() {
+            continue;
+        }
+        let (u0, v0) = (rng.f32() * 0.8, rng.f32() * 0.8);
+        let (u0, v0) = if u0 + v0 > 0.9 { (0.9 - v0, 0.9 - u0) } else { (u0, v0) };
+        let points: Vec<Vec3> = (0..per)
+            .map(|_| tri.point((u0 + rng.f32() * 0.05).min(1.0), (v0 + rng.f32() * 0.05).min(1.0 - u0)))
+            .filter(|x| (*x - light.vertices[0]).dot(light.normal) > 0.0)
+            .collect();
+        if points.len() < per {
+            continue;
+        }
+        made += 1;
+        for x in points {
+            let count = 8 + rng.below(57);
+            let targets = (0..count).map(|_| light.sample(Vec2::new(rng.f32(), rng.f32()))).collect();
+            let leaf = built.octree().locate(x);
+            out.push(Query { x, tri: TriId(t as u32), leaf, light: LightId(li as u32), targets });
+        }
+    }
+    out
+}
+
+#[test]
+fn per_light_answers_from_shafts_equal_per_ray_and_brute_force() {
+    let mut shaft = 0;
+    for name in ["cornell-cube-2", "huis-c", "dragon"] {
+        let scene = plie::scene::builtin::load(name).unwrap();
+        let built = Built::new(&scene, PlieParams::default());
+        let stats = check(&scene, &built, &clustered_queries(&scene, &built, 24, 80, 26));
+        shaft += stats.lights.shaft;
+    }
+    // Some lights were answered from their pieces' shafts (each piece is asked up to 80 times).
+    assert!(shaft > 0, "no light answered from a shaft");
 }
 
 fn cornell() -> &'static (Scene, Built) {

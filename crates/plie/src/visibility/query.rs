@@ -109,6 +109,10 @@ pub struct LightAnswers {
     /// Pairs answered by the scene BVH, all rays at once: their footprints cover cells of different
     /// kinds, long lists, or records that store no list.
     pub scene: u64,
+    /// Pairs whose rays were all tested against the few triangles that meet the shaft from the
+    /// piece of the point's triangle in its leaf to the light (pairs the footprints left to the
+    /// scene BVH, from a piece asked before).
+    pub shaft: u64,
 }
 
 impl std::ops::AddAssign for LightAnswers {
@@ -118,6 +122,7 @@ impl std::ops::AddAssign for LightAnswers {
         self.whole_lit += o.whole_lit;
         self.gathered += o.gathered;
         self.scene += o.scene;
+        self.shaft += o.shaft;
     }
 }
 

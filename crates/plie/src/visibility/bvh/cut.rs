@@ -167,7 +167,7 @@ impl Bvh {
 
     /// The box of child `c` of node `n`, in normalised units, as the walks decode it.
     #[inline]
-    fn child_box(&self, n: u32, c: usize) -> (Vec3, Vec3) {
+    pub(super) fn child_box(&self, n: u32, c: usize) -> (Vec3, Vec3) {
         let node = &self.cw.nodes[n as usize];
         let e = node.compute_extent();
         let lo =

@@ -36,6 +36,7 @@ use crate::scene::{Scene, TriId};
 pub use crowd::CROWD_LIMIT;
 use crowd::{group_crowded_centres, Groups, Prims, Single};
 
+mod collect;
 mod crowd;
 mod cut;
 mod fan_walk;

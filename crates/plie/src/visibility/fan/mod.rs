@@ -418,6 +418,8 @@ pub struct LightScratch {
     pub ranges: Vec<(u32, u32)>,
     /// The stack of a walk down the scene BVH.
     pub walk: WalkStack,
+    /// The list of the current point's shaft (`lie::shafts`).
+    pub shaft: Vec<TriId>,
 }
 
 /// Scratch of a fan's walk down a tree (the scene BVH's, `Bvh::fan_occluded`): the nodes still to

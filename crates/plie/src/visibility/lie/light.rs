@@ -4,14 +4,18 @@
 //! cells or in umbra, or gather the short lists of the cells under them, tested as a fan
 //! ([`super::super::fan`]) with the leaf's own triangles. Any other light (footprints over penumbra
 //! and umbra alike, long lists, records that store no list, a leaf crowded with triangles of its
-//! own) is answered by the scene BVH, all samples at once, starting from the cut of the leaf and the
-//! light (`Bvh::fan_occluded`, [`crate::visibility::bvh::Cut`]): measured, that beat
+//! own) is answered from the few triangles in the shaft of the point's piece of surface where that
+//! piece, asked often and not in a crowded leaf, has them ([`super::shafts`]), else by the scene
+//! BVH, all samples at once,
+//! starting from the cut of the leaf and the light (`Bvh::fan_occluded`,
+//! [`crate::visibility::bvh::Cut`]): measured, that beat
 //! finding each sample's exit face, record and cell and testing its own list on every scene tried
 //! (docs/results.md, session 8).
 
 use super::super::fan::{Fan, LightScratch, Pyramid};
 use super::super::list_boxes::{Chunked, ListVisitor};
 use super::super::{Answer, LightRays, QueryCtx, Visibility, FAN_MIN};
+use super::shafts::Found;
 use super::whole::{Whole, CELL_KEY};
 use super::LieVisibility;
 use crate::geometry::Aabb;
@@ -84,13 +88,20 @@ impl LieVisibility<'_> {
         });
     }
 
-    /// [`Whole::Mixed`]: every sample down the scene BVH at once, for the whole segment, from the
-    /// cut of the leaf and the light ([`crate::visibility::bvh::Cut`]).
+    /// [`Whole::Mixed`]: outside crowded leaves, the triangles in the shaft of the point's piece
+    /// when it has a list ([`super::shafts`]); else every sample down the scene BVH at once, for
+    /// the whole segment, from the cut of the leaf and the light ([`crate::visibility::bvh::Cut`]).
     fn by_scene(&self, leaf: LeafId, rays: &LightRays, sc: &mut LightScratch, out: &mut [bool], ctx: &mut QueryCtx) {
         out.fill(false);
+        sc.fan.pyramid.set_in(self.scene, rays.origin, rays.light);
+        let crowded = self.own[leaf.idx()].1 as usize > OWN_MAX;
+        if !crowded {
+            if let Found::List = self.shaft_list(leaf, rays, &sc.fan.pyramid, &mut sc.shaft, ctx) {
+                return self.by_shaft(rays, sc, out, ctx);
+            }
+        }
         ctx.stats.lights.scene += 1;
         sc.fan.set(rays);
-        sc.fan.pyramid.set_in(self.scene, rays.origin, rays.light);
         let before = ctx.stats.triangle_tests;
         // The cut holds every triangle a segment from the leaf to the light can meet.
         debug_assert!(self.octree.leaf_bounds(leaf).expanded(self.scene.scale() * 1e-5).contains(rays.origin));
@@ -102,6 +113,60 @@ impl LieVisibility<'_> {
 }
 
 impl LieVisibility<'_> {
+    /// A light answered by its piece's shaft ([`super::shafts`]): the triangles in `sc.shaft`
+    /// (those of the shaft that the light's pyramid does not cull) are all that can block,
+    /// tested as a fan; where there are none, every ray is lit without one.
+    fn by_shaft(&self, rays: &LightRays, sc: &mut LightScratch, out: &mut [bool], ctx: &mut QueryCtx) {
+        ctx.stats.lights.shaft += 1;
+        let before = ctx.stats.triangle_tests;
+        if !sc.shaft.is_empty() {
+            sc.fan.set(rays);
+            self.fan_shaft(rays, &sc.shaft, &mut sc.fan, out, ctx);
+        }
+        ctx.stats.blocker_tests += ctx.stats.triangle_tests - before;
+        let hits = out.iter().filter(|&&o| o).count();
+        ctx.stats.answers.count_n(Answer::BlockersHit, hits);
+        ctx.stats.answers.count_n(Answer::BlockersMiss, out.len() - hits);
+    }
+
+    /// [`Self::fan_tris`] over a shaft's list, compiled for AVX2 where the CPU has it.
+    fn fan_shaft(&self, rays: &LightRays, tris: &[TriId], fan: &mut Fan, out: &mut [bool], ctx: &mut QueryCtx) {
+        #[cfg(target_arch = "x86_64")]
+        if std::arch::is_x86_feature_detected!("avx2")
+            && std::arch::is_x86_feature_detected!("popcnt")
+            && std::arch::is_x86_feature_detected!("bmi1")
+        {
+            // SAFETY: AVX2, POPCNT and BMI1 are available (checked above).
+            return unsafe { self.fan_shaft_avx(rays, tris, fan, out, ctx) };
+        }
+        self.fan_shaft_in(rays, tris, fan, out, ctx)
+    }
+
+    /// The body of [`Self::fan_shaft`]: each triangle against the open rays.
+    #[inline(always)]
+    fn fan_shaft_in(&self, rays: &LightRays, tris: &[TriId], fan: &mut Fan, out: &mut [bool], ctx: &mut QueryCtx) {
+        for &t in tris {
+            if fan.live() == 0 {
+                return;
+            }
+            fan.test(self.scene, rays, t, out, ctx);
+        }
+    }
+
+    /// [`Self::fan_shaft`] compiled for AVX2: the same operations, so the same answers.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx,avx2,popcnt,bmi1")]
+    unsafe fn fan_shaft_avx(
+        &self,
+        rays: &LightRays,
+        tris: &[TriId],
+        fan: &mut Fan,
+        out: &mut [bool],
+        ctx: &mut QueryCtx,
+    ) {
+        self.fan_shaft_in(rays, tris, fan, out, ctx)
+    }
+
     /// The blocker list of `key` with its chunk boxes.
     #[inline]
     fn list_of(&self, key: u32) -> Chunked<'_> {

@@ -19,10 +19,12 @@
 //! blocker tests and own-leaf tests (`plie render --stats`).
 //!
 //! All the samples of one light from one point (the per-light query, issue 21) are answered together
-//! in `light.rs`: from the light's footprints on the leaf's faces where they decide it, else by
-//! the scene BVH walked by all the samples at once.
+//! in `light.rs`: from the light's footprints on the leaf's faces where they decide it, else from
+//! the triangles in the shaft of the point's piece of surface (`shafts.rs`) or by the scene BVH
+//! walked by all the samples at once.
 
 mod light;
+mod shafts;
 mod whole;
 
 use super::bvh::{segment_occluded, Bvh, Cut};
@@ -78,6 +80,8 @@ pub struct LieVisibility<'a> {
     cuts: Vec<OnceLock<Box<Cut>>>,
     /// The scene tolerance the cuts' hulls are grown by.
     pad: f32,
+    /// The lists of the pieces of shaded triangles toward lights ([`shafts`]), built on use.
+    shafts: shafts::Shafts,
 }
 
 impl<'a> LieVisibility<'a> {
@@ -123,6 +127,7 @@ impl<'a> LieVisibility<'a> {
             sat,
             cuts,
             pad,
+            shafts: shafts::Shafts::default(),
         }
     }
 
