@@ -4,11 +4,9 @@
 //! triangles that may block any segment from a piece of a shaded triangle to a light
 //! ([`crate::visibility::lie`]'s shafts).
 
-use glam::DVec3;
-
 use super::crowd::{Prims, Single};
-use super::cut::{Child, Cut};
-use super::{Bvh, PAD};
+use super::cut::{Child, Cut, LocalPlane};
+use super::Bvh;
 use crate::construct::shaft::Plane;
 use crate::scene::TriId;
 
@@ -35,17 +33,8 @@ impl Bvh {
         if self.cw.nodes.is_empty() {
             return true;
         }
-        // As `cut_of`: a box of centre `c` and half-size `h` (normalised units), grown by twice the
-        // padding, may meet `n . p <= d` if `n . c - |n| . h + k <= 0`.
-        let (origin, scale) = (self.origin.as_dvec3(), f64::from(self.scale));
-        let planes: Vec<(DVec3, DVec3, f64)> = planes
-            .iter()
-            .map(|p| (p.n, p.n.abs(), (p.n.dot(origin) - p.d) * scale - 2.0 * f64::from(PAD) * p.n.abs().element_sum()))
-            .collect();
-        let keep = |lo: glam::Vec3, hi: glam::Vec3| {
-            let (c, h) = (((lo + hi) * 0.5).as_dvec3(), ((hi - lo) * 0.5).as_dvec3());
-            planes.iter().all(|(n, a, k)| n.dot(c) - a.dot(h) + k <= 0.0)
-        };
+        let planes: Vec<LocalPlane> = planes.iter().map(|p| self.local_plane(p)).collect();
+        let keep = |lo, hi| LocalPlane::all_may_meet(&planes, lo, hi);
         let mut todo: Vec<Child> = Vec::new();
         match cut {
             None => todo.push(Child::Node(0)),

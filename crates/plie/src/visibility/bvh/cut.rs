@@ -14,7 +14,7 @@ use glam::{DVec3, Vec3};
 use obvhs::cwbvh::node::CwBvhNode;
 
 use super::{Bvh, PAD};
-use crate::construct::shaft::Shaft;
+use crate::construct::shaft::{Plane, Shaft};
 use crate::geometry::Aabb;
 
 /// Most entries of a cut: one node's worth of box lanes. Measured (callgrind at 64 rays): 16 cost
@@ -65,29 +65,56 @@ pub(crate) struct Cut {
     pub len: u8,
 }
 
+/// A half-space `n . p <= d` (world units) for tests of the BVH's boxes ([`Bvh::local_plane`]):
+/// a box of centre `c` and half-size `h` in normalised units, grown by twice the padding there, may
+/// meet it if `n . c - |n| . h + k <= 0` (`k` carries `d`, the BVH's origin and scale and the
+/// padding; multiplied through by the scale and in `f64`, its rounding is far below the padding).
+#[derive(Clone, Copy, Debug, Default)]
+pub(super) struct LocalPlane {
+    n: DVec3,
+    abs_n: DVec3,
+    k: f64,
+}
+
+impl LocalPlane {
+    /// False if the box of centre `c` and half-size `h` (normalised units), grown by twice the
+    /// padding, lies wholly beyond the plane.
+    #[inline]
+    pub(super) fn may_meet(&self, c: DVec3, h: DVec3) -> bool {
+        self.n.dot(c) - self.abs_n.dot(h) + self.k <= 0.0
+    }
+
+    /// True if the box `(lo, hi)` (normalised units) may meet every plane of `planes`.
+    #[inline]
+    pub(super) fn all_may_meet(planes: &[LocalPlane], lo: Vec3, hi: Vec3) -> bool {
+        let (c, h) = (((lo + hi) * 0.5).as_dvec3(), ((hi - lo) * 0.5).as_dvec3());
+        planes.iter().all(|p| p.may_meet(c, h))
+    }
+}
+
 impl Bvh {
     /// The cut of the hull of the box `b` and the bounding box of the light polygon `light`, grown
     /// by `pad`: the hull holds every segment from a point of `b` to a point of the light.
     pub(crate) fn cut_of(&self, b: &Aabb, light: &[Vec3], pad: f32) -> Cut {
         let shaft = Shaft::of_boxes(b, &Aabb::from_points(light), pad);
         // The region is the shaft's bounds (the box and the light, grown by `pad`), and `cut` keeps
-        // only boxes that meet it: the shaft's other planes are left to test. A box of centre `c`
-        // and half-size `h` in normalised units, grown by twice the padding there, may meet the
-        // plane `n . p <= d` (world units) if `n . c - |n| . h + k <= 0`, with `k` as below
-        // (multiplied through by the scale; in `f64`, far below the padding in rounding).
-        let (origin, scale) = (self.origin.as_dvec3(), f64::from(self.scale));
-        let mut planes = [(DVec3::ZERO, DVec3::ZERO, 0.0f64); SLANTED_MAX];
+        // only boxes that meet it: the shaft's other planes are left to test.
+        let mut planes = [LocalPlane::default(); SLANTED_MAX];
         let slanted = &shaft.planes[..shaft.planes.len() - 6];
         debug_assert!(slanted.len() <= SLANTED_MAX);
         for (to, p) in planes.iter_mut().zip(slanted) {
-            let k = (p.n.dot(origin) - p.d) * scale - 2.0 * f64::from(PAD) * p.n.abs().element_sum();
-            *to = (p.n, p.n.abs(), k);
+            *to = self.local_plane(p);
         }
         let planes = &planes[..slanted.len().min(SLANTED_MAX)];
-        self.cut(&shaft.bounds, |lo, hi| {
-            let (c, h) = (((lo + hi) * 0.5).as_dvec3(), ((hi - lo) * 0.5).as_dvec3());
-            planes.iter().all(|(n, a, k)| n.dot(c) - a.dot(h) + k <= 0.0)
-        })
+        self.cut(&shaft.bounds, |lo, hi| LocalPlane::all_may_meet(planes, lo, hi))
+    }
+
+    /// The half-space `p` (world units) as the boxes of the BVH (normalised units) are tested
+    /// against it ([`LocalPlane::may_meet`]).
+    pub(super) fn local_plane(&self, p: &Plane) -> LocalPlane {
+        let (origin, scale) = (self.origin.as_dvec3(), f64::from(self.scale));
+        let k = (p.n.dot(origin) - p.d) * scale - 2.0 * f64::from(PAD) * p.n.abs().element_sum();
+        LocalPlane { n: p.n, abs_n: p.n.abs(), k }
     }
 
     /// The cut of the region `region` (world units; see the module documentation), keeping only the

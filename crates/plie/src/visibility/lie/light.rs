@@ -83,18 +83,25 @@ impl LieVisibility<'_> {
                 }
                 Whole::Lit => self.own_only(leaf, rays, sc, out, ctx),
                 Whole::Lists => self.lists_only(leaf, rays, sc, out, ctx),
-                Whole::Mixed => self.by_scene(leaf, rays, sc, out, ctx),
+                Whole::Mixed => self.by_scene(leaf, crowded, rays, sc, out, ctx),
             }
         });
     }
 
-    /// [`Whole::Mixed`]: outside crowded leaves, the triangles in the shaft of the point's piece
+    /// [`Whole::Mixed`]: outside `crowded` leaves, the triangles in the shaft of the point's piece
     /// when it has a list ([`super::shafts`]); else every sample down the scene BVH at once, for
     /// the whole segment, from the cut of the leaf and the light ([`crate::visibility::bvh::Cut`]).
-    fn by_scene(&self, leaf: LeafId, rays: &LightRays, sc: &mut LightScratch, out: &mut [bool], ctx: &mut QueryCtx) {
+    fn by_scene(
+        &self,
+        leaf: LeafId,
+        crowded: bool,
+        rays: &LightRays,
+        sc: &mut LightScratch,
+        out: &mut [bool],
+        ctx: &mut QueryCtx,
+    ) {
         out.fill(false);
         sc.fan.pyramid.set_in(self.scene, rays.origin, rays.light);
-        let crowded = self.own[leaf.idx()].1 as usize > OWN_MAX;
         if !crowded {
             if let Found::List = self.shaft_list(leaf, rays, &sc.fan.pyramid, &mut sc.shaft, ctx) {
                 return self.by_shaft(rays, sc, out, ctx);

@@ -161,10 +161,7 @@ impl LieVisibility<'_> {
                     if !accepts(&within, plane, rays.origin) {
                         return Found::Walk;
                     }
-                    out.clear();
-                    let list = &tris[start as usize..(start + len) as usize];
-                    ctx.stats.box_tests += list.len() as u64;
-                    out.extend(list.iter().filter(|t| !pyramid.culls(&self.scene.triangles[t.idx()])));
+                    self.uncut(&tris[start as usize..(start + len) as usize], pyramid, out, ctx);
                     return Found::List;
                 }
             }
@@ -185,14 +182,20 @@ impl LieVisibility<'_> {
                 s.lists.push(list);
                 s.pieces.insert(key, Piece::List(i));
                 if accepts(&list.within, list.plane, rays.origin) {
-                    ctx.stats.box_tests += out.len() as u64;
-                    out.retain(|t| !pyramid.culls(&self.scene.triangles[t.idx()]));
+                    self.uncut(&s.tris[list.start as usize..], pyramid, out, ctx);
                     Found::List
                 } else {
                     Found::Walk
                 }
             }
         }
+    }
+
+    /// The triangles of a piece's list `list` that `pyramid` does not cull, into `out`.
+    fn uncut(&self, list: &[TriId], pyramid: &Pyramid, out: &mut Vec<TriId>, ctx: &mut QueryCtx) {
+        ctx.stats.box_tests += list.len() as u64;
+        out.clear();
+        out.extend(list.iter().filter(|t| !pyramid.culls(&self.scene.triangles[t.idx()])));
     }
 
     /// The triangles (into `out`) that meet the shaft of the piece of `tri` in `leaf` toward
