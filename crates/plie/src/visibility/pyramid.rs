@@ -1,7 +1,8 @@
 //! The pyramid from a shaded point `x` over a light polygon (issue 21): it contains every shadow ray
 //! from `x` to the light, so a triangle or box beyond one of its planes (grown by a margin) meets
 //! none of them. The per-light query culls its candidates with it before the fan's lane tests
-//! ([`super::fan`]).
+//! ([`super::fan`]). A light of three or four corners has what every pyramid over it needs computed
+//! once ([`PyramidBasis`]), so that a pyramid costs a few lane operations per (point, light) pair.
 
 use glam::{Vec3, Vec4};
 
@@ -23,7 +24,74 @@ pub struct Pyramid {
     margin: f32,
 }
 
+/// What [`Pyramid::set_from`] needs of a light of at most four corners, computed once per light
+/// ([`PyramidBasis::of`]): its corners in lanes as [`Pyramid::set_sides_lanes`] orders them, its
+/// centre, normal and plane offset.
+#[derive(Clone, Copy, Debug)]
+pub struct PyramidBasis {
+    /// Lane `i`: corner `min(i, n - 1)`, per axis.
+    p: [Vec4; 3],
+    /// Lane `i`: the corner after lane `i`'s (the last back to corner 0), per axis.
+    q: [Vec4; 3],
+    /// The first corner.
+    v0: Vec3,
+    /// [`Light::center`].
+    centre: Vec3,
+    /// The light's unit normal and `normal . v0`.
+    cap: (Vec3, f32),
+    /// Corners: 3 or 4.
+    n: usize,
+}
+
+/// The margin every per-light query grows its pyramid by: ten times the scene's tolerance
+/// ([`TOLERANCE_REL`] of its size).
+pub fn margin_of(scene: &Scene) -> f32 {
+    scene.scale() * TOLERANCE_REL * 10.0
+}
+
+impl PyramidBasis {
+    /// The basis of `light`, if it has at most four corners.
+    pub fn of(light: &Light) -> Option<PyramidBasis> {
+        let v = &light.vertices;
+        let n = v.len();
+        if !(3..=4).contains(&n) {
+            return None;
+        }
+        let corner = |i: usize| v[i.min(n - 1)];
+        let next = |i: usize| v[(i.min(n - 1) + 1) % n];
+        let lanes = |f: &dyn Fn(usize) -> Vec3| [0, 1, 2].map(|k| Vec4::new(f(0)[k], f(1)[k], f(2)[k], f(3)[k]));
+        Some(PyramidBasis {
+            p: lanes(&corner),
+            q: lanes(&next),
+            v0: v[0],
+            centre: light.center(),
+            cap: (light.normal, light.normal.dot(v[0])),
+            n,
+        })
+    }
+}
+
 impl Pyramid {
+    /// [`Pyramid::set`] for a light of at most four corners from its precomputed `basis`: the same
+    /// operations on the same values, so the same pyramid, bit for bit.
+    pub fn set_from(&mut self, x: Vec3, basis: &PyramidBasis, margin: f32) -> bool {
+        self.sides.clear();
+        self.lanes = None;
+        self.apex = x;
+        self.margin = margin;
+        let n = basis.cap.0;
+        let h = n.dot(x - basis.v0);
+        self.cap = basis.cap;
+        if h.is_nan() || h <= 4.0 * margin {
+            return false;
+        }
+        let toward_centre = basis.centre - x;
+        // The corners relative to the apex: `v - x` per component, as `Vec3`'s subtraction.
+        let rel = |c: &[Vec4; 3]| [c[0] - Vec4::splat(x.x), c[1] - Vec4::splat(x.y), c[2] - Vec4::splat(x.z)];
+        let ([px, py, pz], [qx, qy, qz]) = (rel(&basis.p), rel(&basis.q));
+        self.set_sides_from_lanes([px, py, pz], [qx, qy, qz], toward_centre, basis.n)
+    }
+
     /// The pyramid from `x` over `light`'s sample domain, grown by `margin` (a length). Returns false
     /// (and leaves an empty pyramid, which culls nothing) if `x` lies too close to the light's plane
     /// for the side planes to be well defined.
@@ -87,6 +155,19 @@ impl Pyramid {
         let lanes = |f: &dyn Fn(usize) -> Vec3, axis: usize| Vec4::new(f(0)[axis], f(1)[axis], f(2)[axis], f(3)[axis]);
         let (px, py, pz) = (lanes(&p, 0), lanes(&p, 1), lanes(&p, 2));
         let (qx, qy, qz) = (lanes(&q, 0), lanes(&q, 1), lanes(&q, 2));
+        self.set_sides_from_lanes([px, py, pz], [qx, qy, qz], toward_centre, n)
+    }
+
+    /// The side planes of the edges `(p, q)` in lanes (relative to the apex) of a polygon of `n`
+    /// corners: the tail of [`Pyramid::set_sides_lanes`] and [`Pyramid::set_from`].
+    #[inline(always)]
+    fn set_sides_from_lanes(
+        &mut self,
+        [px, py, pz]: [Vec4; 3],
+        [qx, qy, qz]: [Vec4; 3],
+        toward_centre: Vec3,
+        n: usize,
+    ) -> bool {
         // p x q, as `Vec3::cross`.
         let (sx, sy, sz) = (py * qz - qy * pz, pz * qx - qz * px, px * qy - qx * py);
         let len = (sx * sx + sy * sy + sz * sz).sqrt();
@@ -97,9 +178,8 @@ impl Pyramid {
         let (sx, sy, sz) = (sx / len, sy / len, sz / len);
         let flip = (sx * toward_centre.x + sy * toward_centre.y + sz * toward_centre.z).cmplt(Vec4::ZERO);
         let (sx, sy, sz) = (Vec4::select(flip, -sx, sx), Vec4::select(flip, -sy, sy), Vec4::select(flip, -sz, sz));
-        for i in 0..n {
-            self.sides.push(Vec3::new(sx[i], sy[i], sz[i]));
-        }
+        let sides = [0, 1, 2, 3].map(|i| Vec3::new(sx[i], sy[i], sz[i]));
+        self.sides.extend_from_slice(&sides[..n]);
         self.lanes = Some([sx, sy, sz]);
         true
     }
@@ -107,7 +187,7 @@ impl Pyramid {
     /// [`Pyramid::set`] from `x` over light `light` of `scene`, grown by the margin every per-light
     /// query uses: ten times the scene's tolerance ([`TOLERANCE_REL`] of its size).
     pub fn set_in(&mut self, scene: &Scene, x: Vec3, light: LightId) -> bool {
-        self.set(x, &scene.lights[light.idx()], scene.scale() * TOLERANCE_REL * 10.0)
+        self.set(x, &scene.lights[light.idx()], margin_of(scene))
     }
 
     /// True if no segment from the apex to a point of the light (within the margin) can meet
@@ -265,6 +345,38 @@ mod tests {
         }
         // Both answers occur.
         assert!(culled > 1000 && culled < 59_000, "{culled}");
+    }
+
+    /// The pyramid from a light's precomputed basis is the one [`Pyramid::set`] makes, bit for bit
+    /// (sides, lanes, cap, and whether it is defined), for a triangle and a skewed quadrilateral
+    /// from random points around them (some too close to the light's plane); a pentagon has no
+    /// basis.
+    #[test]
+    fn basis_sets_the_same_pyramid() {
+        let (o, e1, e3) = (Vec3::new(0.13, 2.0, 0.07), Vec3::new(0.31, 0.02, 0.97), Vec3::new(0.93, -0.01, -0.29));
+        let lights = [vec![o, o + e3, o + e1], vec![o, o + e3, o + e1 + e3, o + e1]];
+        let mut rng = Rng::stream(9, 0, 0, 0);
+        let mut defined = 0;
+        for vertices in lights {
+            let light = Light::new(vertices, Vec3::ONE, vec![]).unwrap();
+            let basis = PyramidBasis::of(&light).expect("at most four corners");
+            for _ in 0..5_000 {
+                let x = Vec3::new(rng.next_f32() * 3.0 - 1.0, rng.next_f32() * 2.1, rng.next_f32() * 3.0 - 1.0);
+                let (mut a, mut b) = (Pyramid::default(), Pyramid::default());
+                let ok = a.set(x, &light, 1e-4);
+                assert_eq!(b.set_from(x, &basis, 1e-4), ok, "{x}");
+                let bits = |p: &Pyramid| {
+                    let sides: Vec<[u32; 3]> = p.sides.iter().map(|s| s.to_array().map(f32::to_bits)).collect();
+                    let lanes = p.lanes.map(|l| l.map(|v| v.to_array().map(f32::to_bits)));
+                    (sides, lanes, p.cap.0.to_array().map(f32::to_bits), p.cap.1.to_bits(), p.apex, p.margin)
+                };
+                assert_eq!(bits(&a), bits(&b), "{x}");
+                defined += usize::from(ok);
+            }
+        }
+        assert!(defined > 5_000 && defined < 10_000, "{defined}");
+        let pentagon = [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.5, 1.5], [0.0, 1.0]].map(|[a, b]| Vec3::new(a, 2.0, b));
+        assert!(PyramidBasis::of(&Light::new(pentagon.to_vec(), Vec3::ONE, vec![]).unwrap()).is_none());
     }
 
     /// Eight boxes at once decide as one at a time, on random boxes around the pyramid.

@@ -24,23 +24,25 @@ pub(super) fn inverse(d: f32) -> f32 {
     }
 }
 
-/// The per-ray values of [`Fan::set`] from the directions `[dx, dy, dz]`, eight rays at a time, as the
-/// scalar loop computes them (the same IEEE operations in the same order, so the same bits): into
-/// `[len, sz, ix, iy, iz]` and `kz`. Returns how many rays it did (a multiple of eight); the caller
-/// does the rest.
+/// The per-ray values of [`super::Fan::set`] for one block of eight directions `(x, y, z)`: their
+/// lengths, the watertight test's `kz` and `1 / d[kz]`, and the inverse directions ([`inverse`]), as
+/// the scalar loop computes them (the same IEEE operations in the same order, so the same bits).
+#[cfg(target_arch = "x86_64")]
+struct RayBlock {
+    len: std::arch::x86_64::__m256,
+    sz: std::arch::x86_64::__m256,
+    ix: std::arch::x86_64::__m256,
+    iy: std::arch::x86_64::__m256,
+    iz: std::arch::x86_64::__m256,
+    kz: std::arch::x86_64::__m256i,
+}
+
+/// [`RayBlock`] of eight directions.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx,avx2")]
 #[inline]
-pub(super) unsafe fn ray_lanes_avx(d: [&[f32]; 3], out: [&mut [f32]; 5], kz: &mut [u32]) -> usize {
+fn ray_block(x: std::arch::x86_64::__m256, y: std::arch::x86_64::__m256, z: std::arch::x86_64::__m256) -> RayBlock {
     use std::arch::x86_64::*;
-    let [dx, dy, dz] = d;
-    let [len, sz, ix, iy, iz] = out;
-    let n = [dx.len(), dy.len(), dz.len(), len.len(), sz.len(), ix.len(), iy.len(), iz.len(), kz.len()]
-        .into_iter()
-        .min()
-        .unwrap_or(0)
-        / LANES
-        * LANES;
     let sign = _mm256_set1_ps(-0.0);
     let (inf, max) = (_mm256_set1_ps(f32::INFINITY), _mm256_set1_ps(f32::MAX));
     let one = _mm256_set1_ps(1.0);
@@ -49,32 +51,20 @@ pub(super) unsafe fn ray_lanes_avx(d: [&[f32]; 3], out: [&mut [f32]; 5], kz: &mu
         let finite = _mm256_cmp_ps::<_CMP_LT_OQ>(_mm256_andnot_ps(sign, i), inf);
         _mm256_blendv_ps(_mm256_or_ps(max, _mm256_and_ps(sign, i)), i, finite)
     };
-    let mut k = 0;
-    while k < n {
-        // SAFETY: k + LANES <= n <= every array's length.
-        unsafe {
-            let (x, y, z) = (
-                _mm256_loadu_ps(dx.as_ptr().add(k)),
-                _mm256_loadu_ps(dy.as_ptr().add(k)),
-                _mm256_loadu_ps(dz.as_ptr().add(k)),
-            );
-            let dot = _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(x, x), _mm256_mul_ps(y, y)), _mm256_mul_ps(z, z));
-            _mm256_storeu_ps(len.as_mut_ptr().add(k), _mm256_sqrt_ps(dot));
-            _mm256_storeu_ps(ix.as_mut_ptr().add(k), inverse(x));
-            _mm256_storeu_ps(iy.as_mut_ptr().add(k), inverse(y));
-            _mm256_storeu_ps(iz.as_mut_ptr().add(k), inverse(z));
-            let (ax, ay, az) = (_mm256_andnot_ps(sign, x), _mm256_andnot_ps(sign, y), _mm256_andnot_ps(sign, z));
-            let c0 = _mm256_and_ps(_mm256_cmp_ps::<_CMP_GE_OQ>(ax, ay), _mm256_cmp_ps::<_CMP_GE_OQ>(ax, az));
-            let c1 = _mm256_cmp_ps::<_CMP_GE_OQ>(ay, az);
-            let dk = _mm256_blendv_ps(_mm256_blendv_ps(z, y, c1), x, c0);
-            _mm256_storeu_ps(sz.as_mut_ptr().add(k), _mm256_div_ps(one, dk));
-            let k12 = _mm256_blendv_ps(_mm256_set1_ps(2.0), one, c1);
-            let kk = _mm256_cvttps_epi32(_mm256_blendv_ps(k12, _mm256_setzero_ps(), c0));
-            _mm256_storeu_si256(kz.as_mut_ptr().add(k).cast(), kk);
-        }
-        k += LANES;
+    let dot = _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(x, x), _mm256_mul_ps(y, y)), _mm256_mul_ps(z, z));
+    let (ax, ay, az) = (_mm256_andnot_ps(sign, x), _mm256_andnot_ps(sign, y), _mm256_andnot_ps(sign, z));
+    let c0 = _mm256_and_ps(_mm256_cmp_ps::<_CMP_GE_OQ>(ax, ay), _mm256_cmp_ps::<_CMP_GE_OQ>(ax, az));
+    let c1 = _mm256_cmp_ps::<_CMP_GE_OQ>(ay, az);
+    let dk = _mm256_blendv_ps(_mm256_blendv_ps(z, y, c1), x, c0);
+    let k12 = _mm256_blendv_ps(_mm256_set1_ps(2.0), one, c1);
+    RayBlock {
+        len: _mm256_sqrt_ps(dot),
+        sz: _mm256_div_ps(one, dk),
+        ix: inverse(x),
+        iy: inverse(y),
+        iz: inverse(z),
+        kz: _mm256_cvttps_epi32(_mm256_blendv_ps(k12, _mm256_setzero_ps(), c0)),
     }
-    n
 }
 
 /// Per lane, `v[k]` for the lane's axis `k` (0, 1 or 2).
@@ -163,8 +153,6 @@ unsafe fn shear_lanes_avx(
 ) -> usize {
     use std::arch::x86_64::*;
     let n = n / LANES * LANES;
-    let (zero, one, two) = (_mm256_setzero_si256(), _mm256_set1_epi32(1), _mm256_set1_epi32(2));
-    let next = |a: __m256i| _mm256_blendv_epi8(_mm256_add_epi32(a, one), zero, _mm256_cmpeq_epi32(a, two));
     let mut j = 0;
     while j < n {
         // SAFETY: j + LANES <= n <= every array's length.
@@ -175,19 +163,126 @@ unsafe fn shear_lanes_avx(
                 _mm256_loadu_ps(d[2].as_ptr().add(j)),
             );
             let kzv = _mm256_loadu_si256(kz.as_ptr().add(j).cast());
-            let pick = |a: __m256i| by_axis(a, [x, y, z]);
-            let (a, b) = (next(kzv), next(next(kzv)));
-            let neg = _mm256_castps_si256(_mm256_cmp_ps::<_CMP_LT_OQ>(pick(kzv), _mm256_setzero_ps()));
-            let (kxv, kyv) = (_mm256_blendv_epi8(a, b, neg), _mm256_blendv_epi8(b, a, neg));
             let szv = _mm256_loadu_ps(sz.as_ptr().add(j));
-            _mm256_storeu_ps(s[0].as_mut_ptr().add(j), _mm256_mul_ps(pick(kxv), szv));
-            _mm256_storeu_ps(s[1].as_mut_ptr().add(j), _mm256_mul_ps(pick(kyv), szv));
+            let (sxv, syv, kxv, kyv) = shear_block([x, y, z], kzv, szv);
+            _mm256_storeu_ps(s[0].as_mut_ptr().add(j), sxv);
+            _mm256_storeu_ps(s[1].as_mut_ptr().add(j), syv);
             _mm256_storeu_si256(k[0].as_mut_ptr().add(j).cast(), kxv);
             _mm256_storeu_si256(k[1].as_mut_ptr().add(j).cast(), kyv);
         }
         j += LANES;
     }
     n
+}
+
+/// [`shear_lanes_avx`] for one block of eight directions `d` with their `kz` and `sz`: `(sx, sy,
+/// kx, ky)`.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx,avx2")]
+#[inline]
+fn shear_block(
+    d: [std::arch::x86_64::__m256; 3],
+    kzv: std::arch::x86_64::__m256i,
+    szv: std::arch::x86_64::__m256,
+) -> (std::arch::x86_64::__m256, std::arch::x86_64::__m256, std::arch::x86_64::__m256i, std::arch::x86_64::__m256i) {
+    use std::arch::x86_64::*;
+    let (zero, one, two) = (_mm256_setzero_si256(), _mm256_set1_epi32(1), _mm256_set1_epi32(2));
+    let next = |a: __m256i| _mm256_blendv_epi8(_mm256_add_epi32(a, one), zero, _mm256_cmpeq_epi32(a, two));
+    // SAFETY: AVX2 is enabled here.
+    let pick = |a: __m256i| unsafe { by_axis(a, d) };
+    let (a, b) = (next(kzv), next(next(kzv)));
+    let neg = _mm256_castps_si256(_mm256_cmp_ps::<_CMP_LT_OQ>(pick(kzv), _mm256_setzero_ps()));
+    let (kxv, kyv) = (_mm256_blendv_epi8(a, b, neg), _mm256_blendv_epi8(b, a, neg));
+    (_mm256_mul_ps(pick(kxv), szv), _mm256_mul_ps(pick(kyv), szv), kxv, kyv)
+}
+
+/// The per-ray values of [`super::Fan::set`] for the blocks of eight points of `ys` (the fan's
+/// targets, from `x`) in one pass: the directions `y - x` (as `Vec3`'s subtraction), [`RayBlock`]
+/// and [`shear_block`], into `all` (`dx, dy, dz, len, sz, ix, iy, iz`), `kz`, the shears `s` and
+/// their axes `k`, each lane as the scalar code computes it. Returns how many points
+/// it did (a multiple of eight); the caller does the rest.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx,avx2")]
+#[inline]
+pub(super) unsafe fn fan_lanes_avx(
+    ys: &[Vec3],
+    x: Vec3,
+    all: &mut [Vec<f32>; 8],
+    kz: &mut [u32],
+    s: &mut [Vec<f32>; 2],
+    k: &mut [Vec<u32>; 2],
+) -> usize {
+    use std::arch::x86_64::*;
+    // The fewest lanes any array holds (loops over arrays of fixed length, so unrolled).
+    let mut n = ys.len().min(kz.len());
+    for v in all.iter() {
+        n = n.min(v.len());
+    }
+    for v in s.iter() {
+        n = n.min(v.len());
+    }
+    for v in k.iter() {
+        n = n.min(v.len());
+    }
+    let n = n / LANES * LANES;
+    let (sx, sy, sz) = (_mm256_set1_ps(x.x), _mm256_set1_ps(x.y), _mm256_set1_ps(x.z));
+    let [dx, dy, dz, len, szs, ix, iy, iz] = all;
+    let ([shx, shy], [kx, ky]) = (s, k);
+    let mut j = 0;
+    while j < n {
+        // SAFETY: j + LANES <= n <= every array's length; `Vec3` is three `f32`s without padding.
+        unsafe {
+            let (px, py, pz) = points_block(ys.as_ptr().add(j).cast::<f32>());
+            let (x, y, z) = (_mm256_sub_ps(px, sx), _mm256_sub_ps(py, sy), _mm256_sub_ps(pz, sz));
+            let r = ray_block(x, y, z);
+            let (sxv, syv, kxv, kyv) = shear_block([x, y, z], r.kz, r.sz);
+            let put = |v: &mut Vec<f32>, a: __m256| _mm256_storeu_ps(v.as_mut_ptr().add(j), a);
+            put(dx, x);
+            put(dy, y);
+            put(dz, z);
+            put(len, r.len);
+            put(szs, r.sz);
+            put(ix, r.ix);
+            put(iy, r.iy);
+            put(iz, r.iz);
+            put(shx, sxv);
+            put(shy, syv);
+            _mm256_storeu_si256(kz.as_mut_ptr().add(j).cast(), r.kz);
+            _mm256_storeu_si256(kx.as_mut_ptr().add(j).cast(), kxv);
+            _mm256_storeu_si256(ky.as_mut_ptr().add(j).cast(), kyv);
+        }
+        j += LANES;
+    }
+    n
+}
+
+/// The coordinates of the eight points (24 floats) at `p`, taken apart with shuffles: `(x, y, z)`.
+///
+/// # Safety
+/// `p` points to 24 readable floats.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx,avx2")]
+#[inline]
+unsafe fn points_block(
+    p: *const f32,
+) -> (std::arch::x86_64::__m256, std::arch::x86_64::__m256, std::arch::x86_64::__m256) {
+    use std::arch::x86_64::*;
+    // SAFETY: the caller's 24 floats.
+    unsafe {
+        let lo = |i: usize| _mm256_castps128_ps256(_mm_loadu_ps(p.add(4 * i)));
+        // x0 y0 z0 x1 | x4 y4 z4 x5, y1 z1 x2 y2 | y5 z5 x6 y6, z2 x3 y3 z3 | z6 x7 y7 z7.
+        let m03 = _mm256_insertf128_ps::<1>(lo(0), _mm_loadu_ps(p.add(12)));
+        let m14 = _mm256_insertf128_ps::<1>(lo(1), _mm_loadu_ps(p.add(16)));
+        let m25 = _mm256_insertf128_ps::<1>(lo(2), _mm_loadu_ps(p.add(20)));
+        // x2 y2 x3 y3 | x6 y6 x7 y7, y0 z0 y1 z1 | y4 z4 y5 z5.
+        let xy = _mm256_shuffle_ps::<0b10_01_11_10>(m14, m25);
+        let yz = _mm256_shuffle_ps::<0b01_00_10_01>(m03, m14);
+        (
+            _mm256_shuffle_ps::<0b10_00_11_00>(m03, xy),
+            _mm256_shuffle_ps::<0b11_01_10_00>(yz, xy),
+            _mm256_shuffle_ps::<0b11_00_11_01>(yz, m25),
+        )
+    }
 }
 
 /// The rays' inverse directions in lanes.
@@ -593,12 +688,15 @@ mod tests {
         }
     }
 
-    /// The eight-lane ray values are the scalar loop's, bit for bit, on ordinary, tied, zero, signed
-    /// zero, tiny and huge components.
+    /// The lanes of a fan equal the scalar formulas bit for bit, on points whose coordinates are
+    /// zeros, tiny, huge and ordinary values (the apex at the origin, so each direction is the
+    /// point): direction, length, `kz` and `1 / d[kz]`, the inverse direction and the shear of the
+    /// ray test.
     #[test]
-    fn ray_lanes_match_the_scalar_loop() {
+    fn fan_lanes_match_the_scalar_formulas() {
         #[cfg(target_arch = "x86_64")]
         if std::arch::is_x86_feature_detected!("avx2") {
+            use crate::geometry::RayTest;
             let special = [0.0, -0.0, 1.0, -1.0, 1e-30, -1e-38, 3e38, -2.5, 0.1, 7.0, -7.0, 1e-45];
             let mut state = 11u64;
             let mut rnd = || {
@@ -606,15 +704,14 @@ mod tests {
                 special[(state % special.len() as u64) as usize] * if state & 1 << 40 != 0 { 1.0 } else { 3.3 }
             };
             let n = 4096;
-            let (dx, dy, dz): (Vec<f32>, Vec<f32>, Vec<f32>) = (0..n).map(|_| (rnd(), rnd(), rnd())).collect();
-            let mut out: [Vec<f32>; 5] = std::array::from_fn(|_| vec![0.0; n]);
+            let ys: Vec<Vec3> = (0..n).map(|_| Vec3::new(rnd(), rnd(), rnd())).collect();
+            let mut all: [Vec<f32>; 8] = std::array::from_fn(|_| vec![0.0; n]);
             let mut kz = vec![0u32; n];
-            let [len, sz, ix, iy, iz] = &mut out;
+            let (mut s, mut k) = ([vec![0.0; n], vec![0.0; n]], [vec![0u32; n], vec![0u32; n]]);
             // SAFETY: AVX2 is available (checked above).
-            let done = unsafe { ray_lanes_avx([&dx, &dy, &dz], [len, sz, ix, iy, iz], &mut kz) };
+            let done = unsafe { fan_lanes_avx(&ys, Vec3::ZERO, &mut all, &mut kz, &mut s, &mut k) };
             assert_eq!(done, n);
-            for k in 0..n {
-                let d = Vec3::new(dx[k], dy[k], dz[k]);
+            for (j, &d) in ys.iter().enumerate() {
                 let a = d.abs();
                 let want_kz = if a.x >= a.y && a.x >= a.z {
                     0
@@ -623,11 +720,36 @@ mod tests {
                 } else {
                     2
                 };
-                let want = [d.length(), 1.0 / d[want_kz], inverse(d.x), inverse(d.y), inverse(d.z)];
-                for (w, (got, want)) in out.iter().map(|v| v[k]).zip(want).enumerate() {
-                    assert_eq!(got.to_bits(), want.to_bits(), "ray {k} {d}: value {w}: {got} against {want}");
+                let want = [d.x, d.y, d.z, d.length(), 1.0 / d[want_kz], inverse(d.x), inverse(d.y), inverse(d.z)];
+                for (w, (got, want)) in all.iter().map(|v| v[j]).zip(want).enumerate() {
+                    assert_eq!(got.to_bits(), want.to_bits(), "ray {j} {d}: value {w}: {got} against {want}");
                 }
-                assert_eq!(kz[k], want_kz as u32, "ray {k} {d}");
+                assert_eq!(kz[j], want_kz as u32, "ray {j} {d}");
+                if d.is_finite() && d != Vec3::ZERO {
+                    let (ws, wk) = RayTest::new(Vec3::ZERO, d, 0.0, 1.0).shear();
+                    assert_eq!(
+                        [s[0][j].to_bits(), s[1][j].to_bits()],
+                        [ws[0].to_bits(), ws[1].to_bits()],
+                        "ray {j} {d}"
+                    );
+                    assert_eq!([k[0][j], k[1][j]], [wk[0], wk[1]], "ray {j} {d}");
+                }
+            }
+            // The points themselves taken apart: from an apex off the origin, `y - x` exactly.
+            let x = Vec3::new(0.3, -7.25, 11.0);
+            let ys: Vec<Vec3> =
+                (0..64).map(|i| Vec3::new(i as f32 * 0.37, 5.0 - i as f32, (i * i) as f32 * 0.01)).collect();
+            let (mut all, mut kz) = (std::array::from_fn(|_| vec![0.0; 64]), vec![0u32; 64]);
+            let (mut s, mut k) = ([vec![0.0; 64], vec![0.0; 64]], [vec![0u32; 64], vec![0u32; 64]]);
+            // SAFETY: AVX2 is available (checked above).
+            assert_eq!(unsafe { fan_lanes_avx(&ys, x, &mut all, &mut kz, &mut s, &mut k) }, 64);
+            for (j, &y) in ys.iter().enumerate() {
+                let d = y - x;
+                assert_eq!(
+                    [all[0][j], all[1][j], all[2][j]].map(f32::to_bits),
+                    d.to_array().map(f32::to_bits),
+                    "point {j}"
+                );
             }
         }
     }

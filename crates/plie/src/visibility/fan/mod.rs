@@ -34,7 +34,7 @@ pub(crate) use lanes::nonzero_bytes;
 mod lanes;
 
 #[cfg(target_arch = "x86_64")]
-use lanes::ray_lanes_avx;
+use lanes::fan_lanes_avx;
 #[cfg(target_arch = "x86_64")]
 use lanes::{exact_avx, Shear};
 use lanes::{inverse, meets_boxes, misses, shear_lanes, BoxLanes, Lanes};
@@ -117,47 +117,47 @@ impl Fan {
             self.open.resize(words, 0);
             self.maybe.resize(words, 0);
         }
-        let [dx, dy, dz, len, sz, ix, iy, iz] = &mut self.all;
-        // Over slices, so that the loop reads and writes without bounds checks.
-        let (dx, dy, dz) = (&mut dx[..n], &mut dy[..n], &mut dz[..n]);
-        for (((y, dx), dy), dz) in rays.targets.iter().zip(dx.iter_mut()).zip(dy.iter_mut()).zip(dz.iter_mut()) {
-            let d = *y - x;
-            (*dx, *dy, *dz) = (d.x, d.y, d.z);
-        }
-        let kzs = &mut self.all_kz[..n];
+        // Whole blocks of eight rays in one pass where the CPU has AVX2; the rest (all of them
+        // without it) ray by ray, as those lanes compute them.
         let mut done = 0;
         #[cfg(target_arch = "x86_64")]
         if std::arch::is_x86_feature_detected!("avx2") {
             // SAFETY: AVX2 is available (checked above).
             done = unsafe {
-                ray_lanes_avx(
-                    [&dx[..n], &dy[..n], &dz[..n]],
-                    [&mut len[..n], &mut sz[..n], &mut ix[..n], &mut iy[..n], &mut iz[..n]],
-                    kzs,
-                )
+                fan_lanes_avx(rays.targets, x, &mut self.all, &mut self.all_kz, &mut self.shear_s, &mut self.shear_k)
             };
         }
-        for k in done..n {
-            let d = Vec3::new(dx[k], dy[k], dz[k]);
-            len[k] = d.length();
-            (ix[k], iy[k], iz[k]) = (inverse(d.x), inverse(d.y), inverse(d.z));
-            // As `RayTest::new` chooses it.
-            let a = d.abs();
-            let kz = if a.x >= a.y && a.x >= a.z {
-                0
-            } else if a.y >= a.z {
-                1
-            } else {
-                2
-            };
-            kzs[k] = kz as u32;
-            sz[k] = 1.0 / d[kz];
-        }
-        {
+        if done < n {
+            let [dx, dy, dz, len, sz, ix, iy, iz] = &mut self.all;
+            let kzs = &mut self.all_kz;
+            for k in done..n {
+                let d = rays.targets[k] - x;
+                (dx[k], dy[k], dz[k]) = (d.x, d.y, d.z);
+                len[k] = d.length();
+                (ix[k], iy[k], iz[k]) = (inverse(d.x), inverse(d.y), inverse(d.z));
+                // As `RayTest::new` chooses it.
+                let a = d.abs();
+                let kz = if a.x >= a.y && a.x >= a.z {
+                    0
+                } else if a.y >= a.z {
+                    1
+                } else {
+                    2
+                };
+                kzs[k] = kz as u32;
+                sz[k] = 1.0 / d[kz];
+            }
             let [dx, dy, dz, _, sz, ..] = &self.all;
             let [sx, sy] = &mut self.shear_s;
             let [kx, ky] = &mut self.shear_k;
-            shear_lanes([&dx[..n], &dy[..n], &dz[..n]], &sz[..n], &self.all_kz[..n], [sx, sy], [kx, ky]);
+            let d = [&dx[done..n], &dy[done..n], &dz[done..n]];
+            shear_lanes(
+                d,
+                &sz[done..n],
+                &self.all_kz[done..n],
+                [&mut sx[done..n], &mut sy[done..n]],
+                [&mut kx[done..n], &mut ky[done..n]],
+            );
         }
         // The padding lanes: zero (a zero direction meets no box and no triangle's cone).
         if padded > n {
@@ -168,13 +168,17 @@ impl Fan {
                 v[n..].fill(0);
             }
         }
-        self.built.fill(0);
-        // Every ray open.
-        self.open.fill(u64::MAX);
+        // Every ray open. (One word, the usual case, without a call to `memset`.)
+        if words == 1 {
+            (self.built[0], self.open[0], self.maybe[0]) = (0, u64::MAX, 0);
+        } else {
+            self.built.fill(0);
+            self.open.fill(u64::MAX);
+            self.maybe.fill(0);
+        }
         if n % 64 != 0 {
             self.open[words - 1] = (1u64 << (n % 64)) - 1;
         }
-        self.maybe.fill(0);
         self.live = n;
     }
 

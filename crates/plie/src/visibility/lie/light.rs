@@ -29,7 +29,7 @@ impl LieVisibility<'_> {
         out.fill(false);
         let tests_before = fan_tests(ctx);
         sc.fan.set(rays);
-        sc.fan.pyramid.set_in(self.scene, rays.origin, rays.light);
+        self.set_pyramid(&mut sc.fan.pyramid, rays.origin, rays.light);
         ctx.begin_query();
         let before = ctx.stats.triangle_tests;
         for &key in &sc.lists {
@@ -101,7 +101,7 @@ impl LieVisibility<'_> {
         ctx: &mut QueryCtx,
     ) {
         out.fill(false);
-        sc.fan.pyramid.set_in(self.scene, rays.origin, rays.light);
+        self.set_pyramid(&mut sc.fan.pyramid, rays.origin, rays.light);
         if !crowded {
             if let Found::List = self.shaft_list(leaf, rays, &sc.fan.pyramid, &mut sc.shaft, ctx) {
                 return self.by_shaft(rays, sc, out, ctx);
@@ -191,7 +191,7 @@ impl LieVisibility<'_> {
     /// leaf itself blocks it. Those meeting the pyramid (usually none) are tested as a fan.
     fn own_only(&self, leaf: LeafId, rays: &LightRays, sc: &mut LightScratch, out: &mut [bool], ctx: &mut QueryCtx) {
         out.fill(false);
-        sc.fan.pyramid.set_in(self.scene, rays.origin, rays.light);
+        self.set_pyramid(&mut sc.fan.pyramid, rays.origin, rays.light);
         let (start, len) = self.own[leaf.idx()];
         let own = self.own_boxes.of(leaf.idx(), &self.own_tris[start as usize..(start + len) as usize]);
         let before = ctx.stats.triangle_tests;

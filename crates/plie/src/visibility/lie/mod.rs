@@ -30,6 +30,7 @@ mod whole;
 use super::bvh::{segment_occluded, Bvh, Cut};
 use super::leaf_voxels::LeafVoxels;
 use super::list_boxes::{Chunked, ListBoxes, ListVisitor};
+use super::pyramid::{self, Pyramid, PyramidBasis};
 use super::{blocks, Answer, LightRays, Mode, OctreeVisibility, QueryCtx, ShadowRay, Visibility};
 use glam::Vec3;
 
@@ -82,6 +83,10 @@ pub struct LieVisibility<'a> {
     pad: f32,
     /// The lists of the pieces of shaded triangles toward lights ([`shafts`]), built on use.
     shafts: shafts::Shafts,
+    /// Per light, its corners in lanes for the pyramid ([`PyramidBasis`]; `None` beyond four).
+    bases: Vec<Option<PyramidBasis>>,
+    /// The margin of every pyramid ([`pyramid::margin_of`]).
+    pyramid_margin: f32,
 }
 
 impl<'a> LieVisibility<'a> {
@@ -128,6 +133,18 @@ impl<'a> LieVisibility<'a> {
             cuts,
             pad,
             shafts: shafts::Shafts::default(),
+            bases: scene.lights.iter().map(PyramidBasis::of).collect(),
+            pyramid_margin: pyramid::margin_of(scene),
+        }
+    }
+
+    /// Sets `pyramid` to the one from `x` over light `light` ([`Pyramid::set_in`]), from the
+    /// light's precomputed basis where it has one.
+    #[inline]
+    fn set_pyramid(&self, pyramid: &mut Pyramid, x: Vec3, light: LightId) -> bool {
+        match &self.bases[light.idx()] {
+            Some(basis) => pyramid.set_from(x, basis, self.pyramid_margin),
+            None => pyramid.set_in(self.scene, x, light),
         }
     }
 
