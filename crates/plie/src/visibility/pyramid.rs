@@ -25,7 +25,7 @@ pub struct Pyramid {
 }
 
 /// What [`Pyramid::set_from`] needs of a light of at most four corners, computed once per light
-/// ([`PyramidBasis::of`]): its corners in lanes as [`Pyramid::set_sides_lanes`] orders them, its
+/// ([`PyramidBasis::of`]): its corners in lanes ([`corner_lanes`]), its
 /// centre, normal and plane offset.
 #[derive(Clone, Copy, Debug)]
 pub struct PyramidBasis {
@@ -57,18 +57,21 @@ impl PyramidBasis {
         if !(3..=4).contains(&n) {
             return None;
         }
-        let corner = |i: usize| v[i.min(n - 1)];
-        let next = |i: usize| v[(i.min(n - 1) + 1) % n];
-        let lanes = |f: &dyn Fn(usize) -> Vec3| [0, 1, 2].map(|k| Vec4::new(f(0)[k], f(1)[k], f(2)[k], f(3)[k]));
-        Some(PyramidBasis {
-            p: lanes(&corner),
-            q: lanes(&next),
-            v0: v[0],
-            centre: light.center(),
-            cap: (light.normal, light.normal.dot(v[0])),
-            n,
-        })
+        let (p, q) = corner_lanes(v);
+        Some(PyramidBasis { p, q, v0: v[0], centre: light.center(), cap: (light.normal, light.normal.dot(v[0])), n })
     }
+}
+
+/// The corners `p` of the edges of a polygon of three or four corners `v`, and the corners `q` they
+/// lead to, in four lanes per axis: lane `i` holds edge `min(i, n - 1)` (a triangle's last edge
+/// twice), the last edge back to corner 0.
+fn corner_lanes(v: &[Vec3]) -> ([Vec4; 3], [Vec4; 3]) {
+    let n = v.len();
+    debug_assert!((3..=4).contains(&n));
+    let corner = |i: usize| v[i.min(n - 1)];
+    let next = |i: usize| v[(i.min(n - 1) + 1) % n];
+    let lanes = |f: &dyn Fn(usize) -> Vec3| [0, 1, 2].map(|k| Vec4::new(f(0)[k], f(1)[k], f(2)[k], f(3)[k]));
+    (lanes(&corner), lanes(&next))
 }
 
 impl Pyramid {
@@ -85,11 +88,7 @@ impl Pyramid {
         if h.is_nan() || h <= 4.0 * margin {
             return false;
         }
-        let toward_centre = basis.centre - x;
-        // The corners relative to the apex: `v - x` per component, as `Vec3`'s subtraction.
-        let rel = |c: &[Vec4; 3]| [c[0] - Vec4::splat(x.x), c[1] - Vec4::splat(x.y), c[2] - Vec4::splat(x.z)];
-        let ([px, py, pz], [qx, qy, qz]) = (rel(&basis.p), rel(&basis.q));
-        self.set_sides_from_lanes([px, py, pz], [qx, qy, qz], toward_centre, basis.n)
+        self.set_sides_from_lanes(x, (&basis.p, &basis.q), basis.centre - x, basis.n)
     }
 
     /// The pyramid from `x` over `light`'s sample domain, grown by `margin` (a length). Returns false
@@ -146,28 +145,23 @@ impl Pyramid {
     /// triangle's last edge twice): the same operations in the same order (`Vec3::cross`,
     /// `length`, the division, `dot`), so the same planes, bit for bit.
     fn set_sides_lanes(&mut self, x: Vec3, v: &[Vec3], toward_centre: Vec3) -> bool {
-        let n = v.len();
-        debug_assert!(n >= 3);
-        // Lane i holds edge min(i, n - 1), from its corner p to the next corner q (the last edge
-        // back to corner 0).
-        let p = |i: usize| v[i.min(n - 1)] - x;
-        let q = |i: usize| v[(i.min(n - 1) + 1) % n] - x;
-        let lanes = |f: &dyn Fn(usize) -> Vec3, axis: usize| Vec4::new(f(0)[axis], f(1)[axis], f(2)[axis], f(3)[axis]);
-        let (px, py, pz) = (lanes(&p, 0), lanes(&p, 1), lanes(&p, 2));
-        let (qx, qy, qz) = (lanes(&q, 0), lanes(&q, 1), lanes(&q, 2));
-        self.set_sides_from_lanes([px, py, pz], [qx, qy, qz], toward_centre, n)
+        let (p, q) = corner_lanes(v);
+        self.set_sides_from_lanes(x, (&p, &q), toward_centre, v.len())
     }
 
-    /// The side planes of the edges `(p, q)` in lanes (relative to the apex) of a polygon of `n`
-    /// corners: the tail of [`Pyramid::set_sides_lanes`] and [`Pyramid::set_from`].
+    /// The side planes seen from `x` of the edges `(p, q)` of a polygon of `n` corners, in lanes
+    /// ([`corner_lanes`]): the body of [`Pyramid::set_sides_lanes`] and [`Pyramid::set_from`].
     #[inline(always)]
     fn set_sides_from_lanes(
         &mut self,
-        [px, py, pz]: [Vec4; 3],
-        [qx, qy, qz]: [Vec4; 3],
+        x: Vec3,
+        (p, q): (&[Vec4; 3], &[Vec4; 3]),
         toward_centre: Vec3,
         n: usize,
     ) -> bool {
+        // The corners relative to the apex: `v - x` per component, as `Vec3`'s subtraction.
+        let rel = |c: &[Vec4; 3]| [c[0] - Vec4::splat(x.x), c[1] - Vec4::splat(x.y), c[2] - Vec4::splat(x.z)];
+        let ([px, py, pz], [qx, qy, qz]) = (rel(p), rel(q));
         // p x q, as `Vec3::cross`.
         let (sx, sy, sz) = (py * qz - qy * pz, pz * qx - qz * px, px * qy - qx * py);
         let len = (sx * sx + sy * sy + sz * sz).sqrt();

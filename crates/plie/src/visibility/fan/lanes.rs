@@ -108,8 +108,9 @@ unsafe fn slab_avx(
 
 /// The rest of each ray's shear for the watertight test, as [`crate::geometry::RayTest::new`]
 /// computes it from the direction `d`, `sz = 1 / d[kz]` and `kz`: the axes `kx = kz + 1`, `ky = kx + 1`
-/// (mod 3, swapped where `d[kz] < 0`) and `sx = d[kx] sz`, `sy = d[ky] sz`, into `s` and `k`. Eight
-/// rays at a time with AVX2 where available, each lane as the scalar code computes it.
+/// (mod 3, swapped where `d[kz] < 0`) and `sx = d[kx] sz`, `sy = d[ky] sz`, into `s` and `k`, lane by
+/// lane: for the rays that [`fan_lanes_avx`] leaves (fewer than eight, or all without AVX2), whose
+/// [`shear_block`] computes each lane as this does.
 #[inline(always)]
 pub(super) fn shear_lanes(d: [&[f32]; 3], sz: &[f32], kz: &[u32], s: [&mut [f32]; 2], k: [&mut [u32]; 2]) {
     let n = d
@@ -120,13 +121,7 @@ pub(super) fn shear_lanes(d: [&[f32]; 3], sz: &[f32], kz: &[u32], s: [&mut [f32]
         .unwrap_or(0);
     let [sx, sy] = s;
     let [kx, ky] = k;
-    let mut done = 0;
-    #[cfg(target_arch = "x86_64")]
-    if std::arch::is_x86_feature_detected!("avx2") {
-        // SAFETY: AVX2 is available (checked above); every array holds at least `n` lanes.
-        done = unsafe { shear_lanes_avx(d, sz, kz, [sx, sy], [kx, ky], n) };
-    }
-    for j in done..n {
+    for j in 0..n {
         let z = kz[j] as usize;
         let (mut x, mut y) = ((z + 1) % 3, (z + 2) % 3);
         if d[z][j] < 0.0 {
@@ -138,45 +133,8 @@ pub(super) fn shear_lanes(d: [&[f32]; 3], sz: &[f32], kz: &[u32], s: [&mut [f32]
     }
 }
 
-/// [`shear_lanes`] for the whole blocks of eight among the first `n` lanes; returns how many lanes
-/// it did.
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx,avx2")]
-#[inline]
-unsafe fn shear_lanes_avx(
-    d: [&[f32]; 3],
-    sz: &[f32],
-    kz: &[u32],
-    s: [&mut [f32]; 2],
-    k: [&mut [u32]; 2],
-    n: usize,
-) -> usize {
-    use std::arch::x86_64::*;
-    let n = n / LANES * LANES;
-    let mut j = 0;
-    while j < n {
-        // SAFETY: j + LANES <= n <= every array's length.
-        unsafe {
-            let (x, y, z) = (
-                _mm256_loadu_ps(d[0].as_ptr().add(j)),
-                _mm256_loadu_ps(d[1].as_ptr().add(j)),
-                _mm256_loadu_ps(d[2].as_ptr().add(j)),
-            );
-            let kzv = _mm256_loadu_si256(kz.as_ptr().add(j).cast());
-            let szv = _mm256_loadu_ps(sz.as_ptr().add(j));
-            let (sxv, syv, kxv, kyv) = shear_block([x, y, z], kzv, szv);
-            _mm256_storeu_ps(s[0].as_mut_ptr().add(j), sxv);
-            _mm256_storeu_ps(s[1].as_mut_ptr().add(j), syv);
-            _mm256_storeu_si256(k[0].as_mut_ptr().add(j).cast(), kxv);
-            _mm256_storeu_si256(k[1].as_mut_ptr().add(j).cast(), kyv);
-        }
-        j += LANES;
-    }
-    n
-}
-
-/// [`shear_lanes_avx`] for one block of eight directions `d` with their `kz` and `sz`: `(sx, sy,
-/// kx, ky)`.
+/// [`shear_lanes`] for one block of eight directions `d` with their `kz` and `sz`: `(sx, sy, kx,
+/// ky)`, each lane as the scalar code computes it.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx,avx2")]
 #[inline]
