@@ -312,6 +312,7 @@ fn print_answers(s: &QueryStats) {
             ("whole lit", l.whole_lit),
             ("gathered", l.gathered),
             ("shaft", l.shaft),
+            ("last blockers", l.last_blockers),
             ("scene BVH", l.scene),
         ] {
             eprintln!("  {name:<14} {n:>12} {:>6.1}%", share(n));

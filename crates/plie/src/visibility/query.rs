@@ -109,6 +109,9 @@ pub struct LightAnswers {
     /// Pairs answered by the scene BVH, all rays at once: their footprints cover cells of different
     /// kinds, long lists, or records that store no list.
     pub scene: u64,
+    /// Pairs the footprints left to the scene BVH whose rays were all occluded by the blockers of
+    /// the light's last walk that found every ray occluded (so without a walk).
+    pub last_blockers: u64,
     /// Pairs whose rays were all tested against the few triangles that meet the shaft from the
     /// piece of the point's triangle in its leaf to the light (pairs the footprints left to the
     /// scene BVH, from a piece asked before).
@@ -122,6 +125,7 @@ impl std::ops::AddAssign for LightAnswers {
         self.whole_lit += o.whole_lit;
         self.gathered += o.gathered;
         self.scene += o.scene;
+        self.last_blockers += o.last_blockers;
         self.shaft += o.shaft;
     }
 }

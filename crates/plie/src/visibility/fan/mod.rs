@@ -74,6 +74,9 @@ pub struct Fan {
     maybe: Vec<u64>,
     /// Rays still open.
     live: usize,
+    /// The first [`BLOCKERS`] triangles that closed a ray since [`Fan::set`] (`u32::MAX` past the
+    /// last).
+    blockers: [u32; BLOCKERS],
     /// The pyramid of the current light.
     pub pyramid: Pyramid,
 }
@@ -180,6 +183,22 @@ impl Fan {
             self.open[words - 1] = (1u64 << (n % 64)) - 1;
         }
         self.live = n;
+        self.blockers = [u32::MAX; BLOCKERS];
+    }
+
+    /// The first triangles (up to [`BLOCKERS`]) that closed a ray since [`Fan::set`], `u32::MAX`
+    /// past the last.
+    #[inline]
+    pub fn blockers(&self) -> [u32; BLOCKERS] {
+        self.blockers
+    }
+
+    /// Notes that `t` closed a ray.
+    #[inline(always)]
+    fn note_blocker(&mut self, t: TriId) {
+        if let Some(b) = self.blockers.iter_mut().find(|b| **b == u32::MAX) {
+            *b = t.0;
+        }
     }
 
     /// Builds the exact tests of the rays `bits` of word `w` that are not built yet.
@@ -205,9 +224,17 @@ impl Fan {
     /// `out[k]` set and is closed. Blocks of eight rays with two or more to test take the
     /// lane-wide copy of the test ([`lanes::exact_avx`]), which answers as it does.
     #[inline(always)]
-    fn exact(&mut self, tri: &Triangle, w: usize, bits: u64, rays: &LightRays, out: &mut [bool], ctx: &mut QueryCtx) {
+    fn exact(
+        &mut self,
+        tri: &Triangle,
+        w: usize,
+        bits: u64,
+        rays: &LightRays,
+        out: &mut [bool],
+        ctx: &mut QueryCtx,
+    ) -> bool {
         if bits == 0 {
-            return;
+            return false;
         }
         ctx.stats.triangle_tests += u64::from(bits.count_ones());
         let mut one_by_one = bits;
@@ -243,11 +270,13 @@ impl Fan {
         }
         self.open[w] &= !hits;
         self.live -= hits.count_ones() as usize;
+        let any = hits != 0;
         while hits != 0 {
             let i = hits.trailing_zeros() as usize;
             hits &= hits - 1;
             out[w * 64 + i] = true;
         }
+        any
     }
 
     /// Words of a mask over the rays (64 rays per word).
@@ -366,9 +395,13 @@ impl Fan {
             Some(_) => (0..words).map(|w| (self.open[w] & mask(w)).count_ones()).sum(),
         };
         if count <= DIRECT_MAX {
+            let mut any = false;
             for w in 0..words {
                 let bits = self.open[w] & mask(w);
-                self.exact(tri, w, bits, rays, out, ctx);
+                any |= self.exact(tri, w, bits, rays, out, ctx);
+            }
+            if any {
+                self.note_blocker(t);
             }
             return;
         }
@@ -398,9 +431,13 @@ impl Fan {
         } else {
             self.maybe.fill(u64::MAX);
         }
+        let mut any = false;
         for w in 0..words {
             let bits = self.maybe[w] & self.open[w] & mask(w);
-            self.exact(tri, w, bits, rays, out, ctx);
+            any |= self.exact(tri, w, bits, rays, out, ctx);
+        }
+        if any {
+            self.note_blocker(t);
         }
     }
 }
@@ -410,6 +447,12 @@ impl Fan {
 /// cornell-bunny and conference-lit, docs/results.md session 9): 16 to 32 needed the fewest
 /// instructions of 3, 8, 16, 24, 32 and 64 once the watertight test ran eight rays wide (3 did before).
 const DIRECT_MAX: u32 = 16;
+
+/// Triangles a fan remembers as having closed rays ([`Fan::blockers`]): the last blockers a
+/// P-LIE mode keeps per light (`lie::light`). Measured (callgrind of the query at 16 and 64 rays on
+/// conference-lit, huis-c, cornell-dragon-100k and cornell-bunny, docs/results.md issue 21 session
+/// 23): 8 needed the fewest instructions of 1, 2, 4, 8 and 16 at 16 rays, and 0.1% more than 16 at 64.
+pub const BLOCKERS: usize = 8;
 
 /// Per-thread scratch of the per-light queries ([`super::Visibility::occluded_light`]).
 #[derive(Clone, Debug, Default)]
@@ -424,6 +467,9 @@ pub struct LightScratch {
     pub walk: WalkStack,
     /// The list of the current point's shaft (`lie::shafts`).
     pub shaft: Vec<TriId>,
+    /// Per light (by index), the blockers of the last walk down the scene BVH that found every
+    /// ray occluded ([`Fan::blockers`]; `u32::MAX` past the last, or for none).
+    pub last_blockers: Vec<[u32; BLOCKERS]>,
 }
 
 /// Scratch of a fan's walk down a tree (the scene BVH's, `Bvh::fan_occluded`): the nodes still to

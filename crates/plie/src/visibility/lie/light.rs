@@ -10,9 +10,11 @@
 //! starting from the cut of the leaf and the light (`Bvh::fan_occluded`,
 //! [`crate::visibility::bvh::Cut`]): measured, that beat
 //! finding each sample's exit face, record and cell and testing its own list on every scene tried
-//! (docs/results.md, session 8).
+//! (docs/results.md, session 8). Before that walk, the blockers of the light's last walk that found
+//! every ray occluded are tested: in shadow that the footprints cannot decide, a neighbouring
+//! pixel's blockers often close every ray, and the walk is not needed.
 
-use super::super::fan::{Fan, LightScratch, Pyramid};
+use super::super::fan::{Fan, LightScratch, Pyramid, BLOCKERS};
 use super::super::list_boxes::{Chunked, ListVisitor};
 use super::super::{Answer, LightRays, QueryCtx, Visibility, FAN_MIN};
 use super::shafts::Found;
@@ -107,19 +109,55 @@ impl LieVisibility<'_> {
                 return self.by_shaft(rays, sc, out, ctx);
             }
         }
-        ctx.stats.lights.scene += 1;
         sc.fan.set(rays);
         let before = ctx.stats.triangle_tests;
-        // The cut holds every triangle a segment from the leaf to the light can meet.
-        debug_assert!(self.octree.leaf_bounds(leaf).expanded(self.scene.scale() * 1e-5).contains(rays.origin));
-        let cut = self.cut(leaf, rays.light);
-        self.bvh.fan_occluded(cut, self.scene, rays, &mut sc.fan, &mut sc.walk, out, ctx);
+        // Where the walk for this light from an earlier point found every ray occluded, its
+        // blockers likely block this point's rays too (a neighbouring pixel): tested first, they
+        // spare the walk where they close every ray.
+        self.test_last_blockers(rays, sc, out, ctx);
+        if sc.fan.live() == 0 {
+            ctx.stats.lights.last_blockers += 1;
+        } else {
+            ctx.stats.lights.scene += 1;
+            // The cut holds every triangle a segment from the leaf to the light can meet.
+            debug_assert!(self.octree.leaf_bounds(leaf).expanded(self.scene.scale() * 1e-5).contains(rays.origin));
+            let cut = self.cut(leaf, rays.light);
+            self.bvh.fan_occluded(cut, self.scene, rays, &mut sc.fan, &mut sc.walk, out, ctx);
+        }
+        if let Some(last) = sc.last_blockers.get_mut(rays.light.idx()) {
+            *last = if sc.fan.live() == 0 { sc.fan.blockers() } else { [u32::MAX; BLOCKERS] };
+        }
         ctx.stats.blocker_tests += ctx.stats.triangle_tests - before;
         ctx.stats.answers.count_n(Answer::SceneBvh, out.len());
     }
 }
 
 impl LieVisibility<'_> {
+    /// Tests the fan's open rays against the light's last blockers (`sc.last_blockers`: those of
+    /// the last walk for the light that found every ray occluded), each but the rays' own
+    /// triangles and those the pyramid culls. Any triangle's exact test is brute force's, so
+    /// testing these first changes no answer, only which triangle closes a ray.
+    fn test_last_blockers(&self, rays: &LightRays, sc: &mut LightScratch, out: &mut [bool], ctx: &mut QueryCtx) {
+        let li = rays.light.idx();
+        if sc.last_blockers.len() <= li {
+            sc.last_blockers.resize(self.scene.lights.len().max(li + 1), [u32::MAX; BLOCKERS]);
+        }
+        for t in sc.last_blockers[li] {
+            // (A scratch used with another scene may name triangles this one lacks.)
+            let Some(tri) = self.scene.triangles.get(t as usize) else { break };
+            let t = TriId(t);
+            if t == rays.origin_tri || self.scene.tri_light[t.idx()] == Some(rays.light) {
+                continue;
+            }
+            if !sc.fan.pyramid.culls(tri) {
+                sc.fan.test(self.scene, rays, t, out, ctx);
+                if sc.fan.live() == 0 {
+                    return;
+                }
+            }
+        }
+    }
+
     /// A light answered by its piece's shaft ([`super::shafts`]): the triangles in `sc.shaft`
     /// (those of the shaft that the light's pyramid does not cull) are all that can block,
     /// tested as a fan; where there are none, every ray is lit without one.
