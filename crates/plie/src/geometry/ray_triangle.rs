@@ -38,14 +38,7 @@ impl RayTest {
     /// Prepares the ray. `dir` must be non-zero and finite.
     pub fn new(origin: Vec3, dir: Vec3, t_min: f32, t_max: f32) -> RayTest {
         debug_assert!(dir.is_finite() && dir != Vec3::ZERO, "bad ray direction {dir}");
-        let a = dir.abs();
-        let kz = if a.x >= a.y && a.x >= a.z {
-            0
-        } else if a.y >= a.z {
-            1
-        } else {
-            2
-        };
+        let kz = RayTest::major_axis(dir);
         let mut kx = (kz + 1) % 3;
         let mut ky = (kx + 1) % 3;
         if dir[kz] < 0.0 {
@@ -53,6 +46,20 @@ impl RayTest {
         }
         let sz = 1.0 / dir[kz];
         RayTest { origin, dir, t_min, t_max, kx, ky, kz, sx: dir[kx] * sz, sy: dir[ky] * sz, sz }
+    }
+
+    /// The axis the test shears along for direction `dir`: that of its largest component (the first
+    /// of equal ones). Lane-wide copies of the test must choose as this does.
+    #[inline]
+    pub fn major_axis(dir: Vec3) -> usize {
+        let a = dir.abs();
+        if a.x >= a.y && a.x >= a.z {
+            0
+        } else if a.y >= a.z {
+            1
+        } else {
+            2
+        }
     }
 
     /// The shear of the test: `[sx, sy, sz]` and the axes `[kx, ky, kz]` (for lane-wide copies of

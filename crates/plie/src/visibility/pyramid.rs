@@ -78,32 +78,29 @@ impl Pyramid {
     /// [`Pyramid::set`] for a light of at most four corners from its precomputed `basis`: the same
     /// operations on the same values, so the same pyramid, bit for bit.
     pub fn set_from(&mut self, x: Vec3, basis: &PyramidBasis, margin: f32) -> bool {
+        self.start(x, basis.cap, basis.v0, margin)
+            && self.set_sides_from_lanes(x, (&basis.p, &basis.q), basis.centre - x, basis.n)
+    }
+
+    /// Empties the pyramid and sets its apex `x`, margin and cap (the light's unit normal and
+    /// offset, `v0` a corner): false if `x` lies too close to the light's plane (within four
+    /// margins) for the side planes to be well defined.
+    fn start(&mut self, x: Vec3, cap: (Vec3, f32), v0: Vec3, margin: f32) -> bool {
         self.sides.clear();
         self.lanes = None;
         self.apex = x;
         self.margin = margin;
-        let n = basis.cap.0;
-        let h = n.dot(x - basis.v0);
-        self.cap = basis.cap;
-        if h.is_nan() || h <= 4.0 * margin {
-            return false;
-        }
-        self.set_sides_from_lanes(x, (&basis.p, &basis.q), basis.centre - x, basis.n)
+        self.cap = cap;
+        let h = cap.0.dot(x - v0);
+        !(h.is_nan() || h <= 4.0 * margin)
     }
 
     /// The pyramid from `x` over `light`'s sample domain, grown by `margin` (a length). Returns false
     /// (and leaves an empty pyramid, which culls nothing) if `x` lies too close to the light's plane
     /// for the side planes to be well defined.
     pub fn set(&mut self, x: Vec3, light: &Light, margin: f32) -> bool {
-        self.sides.clear();
-        self.lanes = None;
-        self.apex = x;
-        self.margin = margin;
-        let n = light.normal;
-        let v = &light.vertices;
-        let h = n.dot(x - v[0]);
-        self.cap = (n, n.dot(v[0]));
-        if h.is_nan() || h <= 4.0 * margin {
+        let (n, v) = (light.normal, &light.vertices);
+        if !self.start(x, (n, n.dot(v[0])), v[0], margin) {
             return false;
         }
         // The sample domain's hull is the polygon (plus, for a parallelogram, its fourth corner

@@ -138,15 +138,7 @@ impl Fan {
                 (dx[k], dy[k], dz[k]) = (d.x, d.y, d.z);
                 len[k] = d.length();
                 (ix[k], iy[k], iz[k]) = (inverse(d.x), inverse(d.y), inverse(d.z));
-                // As `RayTest::new` chooses it.
-                let a = d.abs();
-                let kz = if a.x >= a.y && a.x >= a.z {
-                    0
-                } else if a.y >= a.z {
-                    1
-                } else {
-                    2
-                };
+                let kz = RayTest::major_axis(d);
                 kzs[k] = kz as u32;
                 sz[k] = 1.0 / d[kz];
             }
@@ -224,17 +216,9 @@ impl Fan {
     /// `out[k]` set and is closed. Blocks of eight rays with two or more to test take the
     /// lane-wide copy of the test ([`lanes::exact_avx`]), which answers as it does.
     #[inline(always)]
-    fn exact(
-        &mut self,
-        tri: &Triangle,
-        w: usize,
-        bits: u64,
-        rays: &LightRays,
-        out: &mut [bool],
-        ctx: &mut QueryCtx,
-    ) -> bool {
+    fn exact(&mut self, tri: &Triangle, w: usize, bits: u64, rays: &LightRays, out: &mut [bool], ctx: &mut QueryCtx) {
         if bits == 0 {
-            return false;
+            return;
         }
         ctx.stats.triangle_tests += u64::from(bits.count_ones());
         let mut one_by_one = bits;
@@ -270,13 +254,11 @@ impl Fan {
         }
         self.open[w] &= !hits;
         self.live -= hits.count_ones() as usize;
-        let any = hits != 0;
         while hits != 0 {
             let i = hits.trailing_zeros() as usize;
             hits &= hits - 1;
             out[w * 64 + i] = true;
         }
-        any
     }
 
     /// Words of a mask over the rays (64 rays per word).
@@ -394,49 +376,45 @@ impl Fan {
             None => self.live as u32,
             Some(_) => (0..words).map(|w| (self.open[w] & mask(w)).count_ones()).sum(),
         };
+        let live = self.live;
         if count <= DIRECT_MAX {
-            let mut any = false;
             for w in 0..words {
                 let bits = self.open[w] & mask(w);
-                any |= self.exact(tri, w, bits, rays, out, ctx);
+                self.exact(tri, w, bits, rays, out, ctx);
             }
-            if any {
-                self.note_blocker(t);
-            }
-            return;
-        }
-        let x = self.origin;
-        let (a, b, c) = (tri.v[0] - x, tri.v[1] - x, tri.v[2] - x);
-        // Edge normals scaled by the inverse of their margins: a lane is a sure miss where one scaled
-        // edge function exceeds `|d|` and another is below `-|d|`. (The L1 norm bounds the
-        // Euclidean one, so the margins only grow; the scaling's own rounding is far inside them.)
-        let l1 = |v: Vec3| v.abs().element_sum();
-        let (la, lb, lc) = (l1(a), l1(b), l1(c));
-        let s = [
-            b.cross(c) * (EDGE_MARGIN * lb * lc).recip(),
-            c.cross(a) * (EDGE_MARGIN * lc * la).recip(),
-            a.cross(b) * (EDGE_MARGIN * la * lb).recip(),
-        ];
-        ctx.stats.lane_tests += self.live as u64;
-        // The watertight test's hit parameter is a weighted mean of the vertices' `p[kz] / d[kz]`
-        // (computed as it computes them); lanes where all of them lie outside the segment's range
-        // (beyond a margin for the mean's rounding) miss. Per axis, the least and greatest vertex
-        // coordinate.
-        let (lo, hi) = (a.min(b).min(c), a.max(b).max(c));
-        let span = [(lo.x, hi.x), (lo.y, hi.y), (lo.z, hi.z)];
-        if s.iter().all(|v| v.is_finite()) {
-            let [x, y, z, len, sz, ..] = &self.all;
-            let lanes = Lanes { x, y, z, len, sz, kz: &self.all_kz };
-            misses(&s, &span, &lanes, &mut self.maybe);
         } else {
-            self.maybe.fill(u64::MAX);
+            let x = self.origin;
+            let (a, b, c) = (tri.v[0] - x, tri.v[1] - x, tri.v[2] - x);
+            // Edge normals scaled by the inverse of their margins: a lane is a sure miss where one scaled
+            // edge function exceeds `|d|` and another is below `-|d|`. (The L1 norm bounds the
+            // Euclidean one, so the margins only grow; the scaling's own rounding is far inside them.)
+            let l1 = |v: Vec3| v.abs().element_sum();
+            let (la, lb, lc) = (l1(a), l1(b), l1(c));
+            let s = [
+                b.cross(c) * (EDGE_MARGIN * lb * lc).recip(),
+                c.cross(a) * (EDGE_MARGIN * lc * la).recip(),
+                a.cross(b) * (EDGE_MARGIN * la * lb).recip(),
+            ];
+            ctx.stats.lane_tests += self.live as u64;
+            // The watertight test's hit parameter is a weighted mean of the vertices' `p[kz] / d[kz]`
+            // (computed as it computes them); lanes where all of them lie outside the segment's range
+            // (beyond a margin for the mean's rounding) miss. Per axis, the least and greatest vertex
+            // coordinate.
+            let (lo, hi) = (a.min(b).min(c), a.max(b).max(c));
+            let span = [(lo.x, hi.x), (lo.y, hi.y), (lo.z, hi.z)];
+            if s.iter().all(|v| v.is_finite()) {
+                let [x, y, z, len, sz, ..] = &self.all;
+                let lanes = Lanes { x, y, z, len, sz, kz: &self.all_kz };
+                misses(&s, &span, &lanes, &mut self.maybe);
+            } else {
+                self.maybe.fill(u64::MAX);
+            }
+            for w in 0..words {
+                let bits = self.maybe[w] & self.open[w] & mask(w);
+                self.exact(tri, w, bits, rays, out, ctx);
+            }
         }
-        let mut any = false;
-        for w in 0..words {
-            let bits = self.maybe[w] & self.open[w] & mask(w);
-            any |= self.exact(tri, w, bits, rays, out, ctx);
-        }
-        if any {
+        if self.live < live {
             self.note_blocker(t);
         }
     }

@@ -124,9 +124,8 @@ impl LieVisibility<'_> {
             let cut = self.cut(leaf, rays.light);
             self.bvh.fan_occluded(cut, self.scene, rays, &mut sc.fan, &mut sc.walk, out, ctx);
         }
-        if let Some(last) = sc.last_blockers.get_mut(rays.light.idx()) {
-            *last = if sc.fan.live() == 0 { sc.fan.blockers() } else { [u32::MAX; BLOCKERS] };
-        }
+        // (`test_last_blockers` made room for this light.)
+        sc.last_blockers[rays.light.idx()] = if sc.fan.live() == 0 { sc.fan.blockers() } else { [u32::MAX; BLOCKERS] };
         ctx.stats.blocker_tests += ctx.stats.triangle_tests - before;
         ctx.stats.answers.count_n(Answer::SceneBvh, out.len());
     }
