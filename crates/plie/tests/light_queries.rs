@@ -125,22 +125,39 @@ fn per_light_answers_with_grids_and_a_small_blocker_cap() {
     }
 }
 
+/// The queries with at least `min` samples, the `i`-th of them cut to at most `count(i)`.
+fn cut_to(qs: Vec<Query>, min: usize, count: impl Fn(usize) -> usize) -> Vec<Query> {
+    let kept = qs.into_iter().filter(|q| q.targets.len() >= min);
+    kept.enumerate()
+        .map(|(i, mut q)| {
+            q.targets.truncate(count(i));
+            q
+        })
+        .collect()
+}
+
 /// With 8 to 16 samples (which go straight to the watertight test, without the lane test), the
 /// lights answered through the gathered lists are counted as gathered, not as whole lit.
 #[test]
 fn gathered_lights_are_counted_with_few_samples() {
     let scene = plie::scene::builtin::load("huis-c").unwrap();
     let built = Built::new(&scene, PlieParams::default());
-    let qs: Vec<Query> = queries(&scene, &built, 400, 25)
-        .into_iter()
-        .filter(|q| q.targets.len() >= 8)
-        .map(|mut q| {
-            q.targets.truncate(16);
-            q
-        })
-        .collect();
+    let qs = cut_to(queries(&scene, &built, 400, 25), 8, |_| 16);
     let l = check(&scene, &built, &qs).lights;
     assert!(l.gathered > 0 && l.whole_lit > 0, "{l:?}");
+}
+
+/// Lights with 2 to 7 samples facing the point (the thesis' 4 rays, or a light partly behind the
+/// point) are answered by the P-LIE modes as a fan too (`FAN_MIN`), as per ray and as brute
+/// force.
+#[test]
+fn few_samples_are_answered_per_light() {
+    let scene = plie::scene::builtin::load("huis-c").unwrap();
+    let built = Built::new(&scene, PlieParams::default());
+    let qs = cut_to(queries(&scene, &built, 400, 28), 7, |i| 2 + i % 6);
+    let l = check(&scene, &built, &qs).lights;
+    // Each P-LIE mode answers every query per light (one mode alone would count them all).
+    assert!(l.queries >= qs.len() as u64, "{} of {} queries per light: {l:?}", l.queries, qs.len());
 }
 
 /// The refined P-LIE (split leaves) answers per light as per ray too.

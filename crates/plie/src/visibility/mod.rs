@@ -49,9 +49,15 @@ pub(crate) fn wall_scene() -> (crate::Scene, crate::TriId) {
     (b.build().expect("valid scene"), floor)
 }
 
-/// Fewer samples of a light than this are asked ray by ray by the per-light queries: with so few,
-/// sharing work does not pay (measured at 4 samples per light, `plie bench --soft-shadows`).
-pub(crate) const FAN_MIN: usize = 8;
+/// Fewer samples of a light facing the point than this are asked ray by ray by the per-light
+/// queries (the `bvh` and P-LIE modes); from this many on, the light is answered as a fan.
+/// Measured (callgrind inside `occluded_light`, 254x254, 4 rays, docs/results.md issue 21 session
+/// 24), 8 (before) against 2: `grid` on conference-lit 1,444.5 -> 635.1 M instructions, huis-c
+/// 1,451.6 -> 541.1, cornell-dragon-100k 707.7 -> 402.0, cornell-bunny 382.2 -> 244.5 (1 instead of
+/// 2: up to 0.8% more); `bvh` 832.7 -> 772.0, 748.6 -> 690.3, 518.4 -> 498.8 and 257.1 -> 281.0 M
+/// (-4.9% in sum). At 16 rays, where only lights partly behind the point have fewer than 8 samples,
+/// 2 saved `grid` 1.2% in sum.
+pub(crate) const FAN_MIN: usize = 2;
 
 /// A visibility method: answers shadow-ray queries exactly (but for the reference modes that say
 /// otherwise: [`Mode::None`] and native Embree, [`Mode::is_exact`]).

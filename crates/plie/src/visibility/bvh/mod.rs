@@ -211,8 +211,11 @@ impl Visibility for BvhVisibility<'_> {
         segment_occluded(self.scene, self.bvh, ray, ctx)
     }
 
-    /// All samples of the light down the BVH at once (`Bvh::fan_occluded`), as a packet; a few
-    /// samples ray by ray.
+    /// All samples of the light down the BVH at once (`Bvh::fan_occluded`), as a packet; fewer
+    /// than `visibility::FAN_MIN` samples ray by ray. As the P-LIE modes do before their walks,
+    /// the blockers of the light's last walk that found every ray occluded are tested first
+    /// (`LightScratch::test_last_blockers`): coherence between pixels
+    /// that any renderer can keep, so the peer keeps it too.
     fn occluded_light(&self, rays: &LightRays, out: &mut [bool], ctx: &mut QueryCtx) {
         if rays.targets.len() < crate::visibility::FAN_MIN {
             for (k, o) in out.iter_mut().enumerate() {
@@ -224,7 +227,11 @@ impl Visibility for BvhVisibility<'_> {
             out.fill(false);
             sc.fan.set(rays);
             sc.fan.pyramid.set_in(self.scene, rays.origin, rays.light);
-            self.bvh.fan_occluded(None, self.scene, rays, &mut sc.fan, &mut sc.walk, out, ctx);
+            sc.test_last_blockers(self.scene, rays, out, ctx);
+            if sc.fan.live() > 0 {
+                self.bvh.fan_occluded(None, self.scene, rays, &mut sc.fan, &mut sc.walk, out, ctx);
+            }
+            sc.keep_blockers(rays);
         });
     }
 }

@@ -157,8 +157,9 @@ fn shear_block(
 /// The per-ray values of [`super::Fan::set`] for the blocks of eight points of `ys` (the fan's
 /// targets, from `x`) in one pass: the directions `y - x` (as `Vec3`'s subtraction), [`RayBlock`]
 /// and [`shear_block`], into `all` (`dx, dy, dz, len, sz, ix, iy, iz`), `kz`, the shears `s` and
-/// their axes `k`, each lane as the scalar code computes it. Returns how many points
-/// it did (a multiple of eight); the caller does the rest.
+/// their axes `k`, each lane as the scalar code computes it. Returns how many points it did: all
+/// of them where the arrays have room for whole blocks, else a multiple of eight (the caller does
+/// the rest).
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx,avx2")]
 #[inline]
@@ -172,46 +173,58 @@ pub(super) unsafe fn fan_lanes_avx(
 ) -> usize {
     use std::arch::x86_64::*;
     // The fewest lanes any array holds (loops over arrays of fixed length, so unrolled).
-    let mut n = ys.len().min(kz.len());
+    let mut room = kz.len();
     for v in all.iter() {
-        n = n.min(v.len());
+        room = room.min(v.len());
     }
     for v in s.iter() {
-        n = n.min(v.len());
+        room = room.min(v.len());
     }
     for v in k.iter() {
-        n = n.min(v.len());
+        room = room.min(v.len());
     }
-    let n = n / LANES * LANES;
+    let n = ys.len().min(room) / LANES * LANES;
     let (sx, sy, sz) = (_mm256_set1_ps(x.x), _mm256_set1_ps(x.y), _mm256_set1_ps(x.z));
     let [dx, dy, dz, len, szs, ix, iy, iz] = all;
     let ([shx, shy], [kx, ky]) = (s, k);
+    // The lanes `j..j + 8` from the eight points at `p`.
+    // SAFETY (of each call below): `p` points to eight points and j + LANES <= room.
+    let mut block = |p: *const Vec3, j: usize| unsafe {
+        let (px, py, pz) = points_block(p.cast::<f32>());
+        let (x, y, z) = (_mm256_sub_ps(px, sx), _mm256_sub_ps(py, sy), _mm256_sub_ps(pz, sz));
+        let r = ray_block(x, y, z);
+        let (sxv, syv, kxv, kyv) = shear_block([x, y, z], r.kz, r.sz);
+        let put = |v: &mut Vec<f32>, a: __m256| _mm256_storeu_ps(v.as_mut_ptr().add(j), a);
+        put(dx, x);
+        put(dy, y);
+        put(dz, z);
+        put(len, r.len);
+        put(szs, r.sz);
+        put(ix, r.ix);
+        put(iy, r.iy);
+        put(iz, r.iz);
+        put(shx, sxv);
+        put(shy, syv);
+        _mm256_storeu_si256(kz.as_mut_ptr().add(j).cast(), r.kz);
+        _mm256_storeu_si256(kx.as_mut_ptr().add(j).cast(), kxv);
+        _mm256_storeu_si256(ky.as_mut_ptr().add(j).cast(), kyv);
+    };
     let mut j = 0;
     while j < n {
-        // SAFETY: j + LANES <= n <= every array's length; `Vec3` is three `f32`s without padding.
-        unsafe {
-            let (px, py, pz) = points_block(ys.as_ptr().add(j).cast::<f32>());
-            let (x, y, z) = (_mm256_sub_ps(px, sx), _mm256_sub_ps(py, sy), _mm256_sub_ps(pz, sz));
-            let r = ray_block(x, y, z);
-            let (sxv, syv, kxv, kyv) = shear_block([x, y, z], r.kz, r.sz);
-            let put = |v: &mut Vec<f32>, a: __m256| _mm256_storeu_ps(v.as_mut_ptr().add(j), a);
-            put(dx, x);
-            put(dy, y);
-            put(dz, z);
-            put(len, r.len);
-            put(szs, r.sz);
-            put(ix, r.ix);
-            put(iy, r.iy);
-            put(iz, r.iz);
-            put(shx, sxv);
-            put(shy, syv);
-            _mm256_storeu_si256(kz.as_mut_ptr().add(j).cast(), r.kz);
-            _mm256_storeu_si256(kx.as_mut_ptr().add(j).cast(), kxv);
-            _mm256_storeu_si256(ky.as_mut_ptr().add(j).cast(), kyv);
-        }
+        // (j + LANES <= n <= ys.len(); `Vec3` is three `f32`s without padding.)
+        block(ys[j..].as_ptr(), j);
         j += LANES;
     }
-    n
+    // A last, partial block where the arrays have room for a whole one (a fan padded to whole
+    // blocks): its points copied into eight, the rest of them the apex (the caller overwrites
+    // those lanes).
+    if j < ys.len() && j + LANES <= room {
+        let mut last = [x; LANES];
+        last[..ys.len() - j].copy_from_slice(&ys[j..]);
+        block(last.as_ptr(), j);
+        j = ys.len();
+    }
+    j
 }
 
 /// The coordinates of the eight points (24 floats) at `p`, taken apart with shuffles: `(x, y, z)`.
@@ -661,14 +674,22 @@ mod tests {
                 state = crate::render::sampler::mix64(state);
                 special[(state % special.len() as u64) as usize] * if state & 1 << 40 != 0 { 1.0 } else { 3.3 }
             };
-            let n = 4096;
+            // Points ending in a partial block, in arrays with room for a whole one.
+            let (n, room) = (4093, 4096);
             let ys: Vec<Vec3> = (0..n).map(|_| Vec3::new(rnd(), rnd(), rnd())).collect();
-            let mut all: [Vec<f32>; 8] = std::array::from_fn(|_| vec![0.0; n]);
-            let mut kz = vec![0u32; n];
-            let (mut s, mut k) = ([vec![0.0; n], vec![0.0; n]], [vec![0u32; n], vec![0u32; n]]);
+            let mut all: [Vec<f32>; 8] = std::array::from_fn(|_| vec![0.0; room]);
+            let mut kz = vec![0u32; room];
+            let (mut s, mut k) = ([vec![0.0; room], vec![0.0; room]], [vec![0u32; room], vec![0u32; room]]);
             // SAFETY: AVX2 is available (checked above).
             let done = unsafe { fan_lanes_avx(&ys, Vec3::ZERO, &mut all, &mut kz, &mut s, &mut k) };
             assert_eq!(done, n);
+            // Without room for the last block, only the whole blocks.
+            let mut short: [Vec<f32>; 8] = std::array::from_fn(|_| vec![0.0; n]);
+            let (mut s2, mut k2, mut kz2) =
+                ([vec![0.0; n], vec![0.0; n]], [vec![0u32; n], vec![0u32; n]], vec![0u32; n]);
+            // SAFETY: as above.
+            let whole = unsafe { fan_lanes_avx(&ys, Vec3::ZERO, &mut short, &mut kz2, &mut s2, &mut k2) };
+            assert_eq!(whole, n / LANES * LANES);
             for (j, &d) in ys.iter().enumerate() {
                 let a = d.abs();
                 let want_kz = if a.x >= a.y && a.x >= a.z {

@@ -120,8 +120,8 @@ impl Fan {
             self.open.resize(words, 0);
             self.maybe.resize(words, 0);
         }
-        // Whole blocks of eight rays in one pass where the CPU has AVX2; the rest (all of them
-        // without it) ray by ray, as those lanes compute them.
+        // Blocks of eight rays in one pass where the CPU has AVX2 (the last one padded: the
+        // arrays hold whole blocks); without it, ray by ray, as those lanes compute them.
         let mut done = 0;
         #[cfg(target_arch = "x86_64")]
         if std::arch::is_x86_feature_detected!("avx2") {
@@ -448,6 +448,43 @@ pub struct LightScratch {
     /// Per light (by index), the blockers of the last walk down the scene BVH that found every
     /// ray occluded ([`Fan::blockers`]; `u32::MAX` past the last, or for none).
     pub last_blockers: Vec<[u32; BLOCKERS]>,
+}
+
+impl LightScratch {
+    /// Tests the fan's open rays against the light's last blockers (`last_blockers`: those of the
+    /// last walk for the light that found every ray occluded, [`LightScratch::keep_blockers`]),
+    /// each but the rays' own triangles and those the fan's pyramid culls. The caller has set the
+    /// fan and its pyramid. Any triangle's exact test is brute force's, so testing these first
+    /// changes no answer, only which triangle closes a ray: in shadow, a neighbouring pixel's
+    /// blockers often close every ray, and the walk is not needed.
+    pub fn test_last_blockers(&mut self, scene: &Scene, rays: &LightRays, out: &mut [bool], ctx: &mut QueryCtx) {
+        let li = rays.light.idx();
+        if self.last_blockers.len() <= li {
+            self.last_blockers.resize(scene.lights.len().max(li + 1), [u32::MAX; BLOCKERS]);
+        }
+        for t in self.last_blockers[li] {
+            // (A scratch used with another scene may name triangles this one lacks.)
+            let Some(tri) = scene.triangles.get(t as usize) else { break };
+            let t = TriId(t);
+            if t == rays.origin_tri || scene.tri_light[t.idx()] == Some(rays.light) {
+                continue;
+            }
+            if !self.fan.pyramid.culls(tri) {
+                self.fan.test(scene, rays, t, out, ctx);
+                if self.fan.live() == 0 {
+                    return;
+                }
+            }
+        }
+    }
+
+    /// After a walk for `rays.light` (preceded by [`LightScratch::test_last_blockers`]): keeps
+    /// the fan's blockers as the light's last ones if every ray is occluded, else forgets them.
+    pub fn keep_blockers(&mut self, rays: &LightRays) {
+        // (`test_last_blockers` made room for this light.)
+        self.last_blockers[rays.light.idx()] =
+            if self.fan.live() == 0 { self.fan.blockers() } else { [u32::MAX; BLOCKERS] };
+    }
 }
 
 /// Scratch of a fan's walk down a tree (the scene BVH's, `Bvh::fan_occluded`): the nodes still to

@@ -14,7 +14,7 @@
 //! every ray occluded are tested: in shadow that the footprints cannot decide, a neighbouring
 //! pixel's blockers often close every ray, and the walk is not needed.
 
-use super::super::fan::{Fan, LightScratch, Pyramid, BLOCKERS};
+use super::super::fan::{Fan, LightScratch, Pyramid};
 use super::super::list_boxes::{Chunked, ListVisitor};
 use super::super::{Answer, LightRays, QueryCtx, Visibility, FAN_MIN};
 use super::shafts::Found;
@@ -114,7 +114,7 @@ impl LieVisibility<'_> {
         // Where the walk for this light from an earlier point found every ray occluded, its
         // blockers likely block this point's rays too (a neighbouring pixel): tested first, they
         // spare the walk where they close every ray.
-        self.test_last_blockers(rays, sc, out, ctx);
+        sc.test_last_blockers(self.scene, rays, out, ctx);
         if sc.fan.live() == 0 {
             ctx.stats.lights.last_blockers += 1;
         } else {
@@ -124,39 +124,13 @@ impl LieVisibility<'_> {
             let cut = self.cut(leaf, rays.light);
             self.bvh.fan_occluded(cut, self.scene, rays, &mut sc.fan, &mut sc.walk, out, ctx);
         }
-        // (`test_last_blockers` made room for this light.)
-        sc.last_blockers[rays.light.idx()] = if sc.fan.live() == 0 { sc.fan.blockers() } else { [u32::MAX; BLOCKERS] };
+        sc.keep_blockers(rays);
         ctx.stats.blocker_tests += ctx.stats.triangle_tests - before;
         ctx.stats.answers.count_n(Answer::SceneBvh, out.len());
     }
 }
 
 impl LieVisibility<'_> {
-    /// Tests the fan's open rays against the light's last blockers (`sc.last_blockers`: those of
-    /// the last walk for the light that found every ray occluded), each but the rays' own
-    /// triangles and those the pyramid culls. Any triangle's exact test is brute force's, so
-    /// testing these first changes no answer, only which triangle closes a ray.
-    fn test_last_blockers(&self, rays: &LightRays, sc: &mut LightScratch, out: &mut [bool], ctx: &mut QueryCtx) {
-        let li = rays.light.idx();
-        if sc.last_blockers.len() <= li {
-            sc.last_blockers.resize(self.scene.lights.len().max(li + 1), [u32::MAX; BLOCKERS]);
-        }
-        for t in sc.last_blockers[li] {
-            // (A scratch used with another scene may name triangles this one lacks.)
-            let Some(tri) = self.scene.triangles.get(t as usize) else { break };
-            let t = TriId(t);
-            if t == rays.origin_tri || self.scene.tri_light[t.idx()] == Some(rays.light) {
-                continue;
-            }
-            if !sc.fan.pyramid.culls(tri) {
-                sc.fan.test(self.scene, rays, t, out, ctx);
-                if sc.fan.live() == 0 {
-                    return;
-                }
-            }
-        }
-    }
-
     /// A light answered by its piece's shaft ([`super::shafts`]): the triangles in `sc.shaft`
     /// (those of the shaft that the light's pyramid does not cull) are all that can block,
     /// tested as a fan; where there are none, every ray is lit without one.

@@ -57,7 +57,7 @@ const BUILD_AT: u32 = 32;
 
 /// The planes' margin, in scene tolerances ([`LieVisibility::pad`]): a segment from an accepted
 /// point lies this many tolerances inside each plane, but for rounding (the pyramid's cull keeps
-/// ten, [`crate::visibility::pyramid::Pyramid::set_in`]).
+/// ten, [`crate::visibility::pyramid::margin_of`]).
 const SHAFT_MARGIN: f32 = 16.0;
 
 /// Most pieces the table holds: about 32 bytes each in the table, and about 112 more for those
