@@ -342,6 +342,41 @@ fn each_box(lo: &[[f32; 8]; 3], hi: &[[f32; 8]; 3], alive: u8, out: &mut [u64; 8
     }
 }
 
+/// Of the eight boxes `c` with bit `c` of `alive` set, given as lanes relative to the apex
+/// (`lo[axis][c]`, `hi[axis][c]`), those that the segment of ray `j` meets, as bits: [`meets_box`]'s
+/// test of one ray against eight boxes.
+#[inline(always)]
+pub(super) fn ray_meets_boxes(lo: &[[f32; 8]; 3], hi: &[[f32; 8]; 3], alive: u8, lanes: &BoxLanes, j: usize) -> u8 {
+    #[cfg(target_arch = "x86_64")]
+    if std::arch::is_x86_feature_detected!("avx2") {
+        // SAFETY: AVX2 is available (checked above).
+        return unsafe { ray_meets_boxes_avx(lo, hi, alive, lanes, j) };
+    }
+    let corner = |v: &[[f32; 8]; 3], c: usize| Vec3::new(v[0][c], v[1][c], v[2][c]);
+    let (base, bit) = (j / 64 * 64, 1u64 << (j % 64));
+    (0..8)
+        .filter(|&c| alive >> c & 1 != 0 && meets_box(corner(lo, c), corner(hi, c), lanes, base, bit) != 0)
+        .fold(0, |m, c| m | 1 << c)
+}
+
+/// [`ray_meets_boxes`] with the eight boxes in lanes: [`slab_avx`], as every box test of a fan.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx,avx2")]
+#[inline]
+unsafe fn ray_meets_boxes_avx(lo: &[[f32; 8]; 3], hi: &[[f32; 8]; 3], alive: u8, lanes: &BoxLanes, j: usize) -> u8 {
+    use std::arch::x86_64::*;
+    // SAFETY: eight floats each.
+    let (l, h) = unsafe {
+        (
+            [_mm256_loadu_ps(lo[0].as_ptr()), _mm256_loadu_ps(lo[1].as_ptr()), _mm256_loadu_ps(lo[2].as_ptr())],
+            [_mm256_loadu_ps(hi[0].as_ptr()), _mm256_loadu_ps(hi[1].as_ptr()), _mm256_loadu_ps(hi[2].as_ptr())],
+        )
+    };
+    let inv = [_mm256_set1_ps(lanes.ix[j]), _mm256_set1_ps(lanes.iy[j]), _mm256_set1_ps(lanes.iz[j])];
+    // SAFETY: AVX2 is enabled here.
+    (unsafe { slab_avx(l, h, inv) } as u8) & alive
+}
+
 /// [`meets_boxes`] with the eight boxes in lanes and one ray at a time: cheaper than eight rays
 /// at a time when the rays of `within` are few and spread over many blocks of eight. Each (ray, box)
 /// is decided by [`slab_avx`], as in [`meets_box_avx`], so with the same answer.
@@ -733,8 +768,8 @@ mod tests {
         }
     }
 
-    /// One ray at a time, the eight-box test answers as eight rays at a time, on random boxes
-    /// and directions (zero and tiny components included).
+    /// One ray at a time, the eight-box test answers as eight rays at a time, and so does one ray
+    /// alone, on random boxes and directions (zero and tiny components included).
     #[test]
     fn box_tests_by_ray_and_by_block_agree() {
         #[cfg(target_arch = "x86_64")]
@@ -769,6 +804,11 @@ mod tests {
                     meets_boxes_by_ray_avx(&lo, &hi, alive, &lanes, 0, within, &mut by_ray);
                 }
                 assert_eq!(by_block, by_ray, "round {round}");
+                // One ray alone against the eight boxes (the walk's `ray_walk`) answers alike.
+                for j in (0..64).filter(|j| within >> j & 1 != 0) {
+                    let want = (0..8).fold(0u8, |m, c| m | u8::from(by_block[c] >> j & 1 != 0) << c);
+                    assert_eq!(ray_meets_boxes(&lo, &hi, alive, &lanes, j), want, "round {round}, ray {j}");
+                }
                 met += by_ray.iter().map(|m| m.count_ones()).sum::<u32>();
             }
             assert!(met > 1000, "{met}");

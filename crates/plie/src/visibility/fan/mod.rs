@@ -37,7 +37,7 @@ mod lanes;
 use lanes::fan_lanes_avx;
 #[cfg(target_arch = "x86_64")]
 use lanes::{exact_avx, Shear};
-use lanes::{inverse, meets_boxes, misses, shear_lanes, BoxLanes, Lanes};
+use lanes::{inverse, meets_boxes, misses, ray_meets_boxes, shear_lanes, BoxLanes, Lanes};
 
 /// Relative margin of the edge functions. The watertight test's sheared edge function of an edge
 /// `(p, q)` differs from the real `det(p, q, d) / d_kz` by at most about `32 ε |p| |q|` (the shear has
@@ -324,6 +324,16 @@ impl Fan {
         hit
     }
 
+    /// Of the eight boxes `c` with bit `c` of `alive` set, given relative to the apex as lanes, those
+    /// that the segment of ray `k` meets, as bits: [`Fan::meets8`]'s test for one ray. Counts a box
+    /// test per box tested.
+    #[inline(always)]
+    pub fn ray_meets8(&self, lo: &[[f32; 8]; 3], hi: &[[f32; 8]; 3], alive: u8, k: usize, ctx: &mut QueryCtx) -> u8 {
+        let [.., ix, iy, iz] = &self.all;
+        ctx.stats.box_tests += u64::from(alive.count_ones());
+        ray_meets_boxes(lo, hi, alive, &BoxLanes { ix, iy, iz }, k)
+    }
+
     /// [`Fan::test`] for the open lanes of `within` only: up to [`DIRECT_MAX`] lanes go straight to
     /// the watertight test, more first through the eight-lane edge test.
     #[inline]
@@ -488,12 +498,15 @@ impl LightScratch {
 }
 
 /// Scratch of a fan's walk down a tree (the scene BVH's, `Bvh::fan_occluded`): the nodes still to
-/// visit, each with its mask of rays (one after the other in `masks`), and the masks of the node
-/// being visited and of its eight children.
+/// visit, each with its mask of rays (one after the other in `masks`), the masks of the node
+/// being visited and of its eight children, and the nodes and mask of a ray walking a subtree
+/// alone.
 #[derive(Clone, Debug, Default)]
 pub struct WalkStack {
     pub nodes: Vec<u32>,
     pub masks: Vec<u64>,
     pub node_mask: Vec<u64>,
     pub child_masks: Vec<u64>,
+    pub ray_nodes: Vec<u32>,
+    pub ray_mask: Vec<u64>,
 }
