@@ -60,6 +60,13 @@ pub struct LightRays<'a> {
 }
 
 impl LightRays<'_> {
+    /// True for the rays' own triangles, which never block them (as in [`blocks`]): the one the
+    /// point lies on and the light's.
+    #[inline(always)]
+    pub fn own(&self, scene: &Scene, t: TriId) -> bool {
+        t == self.origin_tri || scene.tri_light[t.idx()] == Some(self.light)
+    }
+
     /// The `k`-th shadow ray.
     #[inline]
     pub fn ray(&self, k: usize) -> ShadowRay {

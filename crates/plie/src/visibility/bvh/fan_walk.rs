@@ -242,15 +242,7 @@ impl Bvh {
                 match Child::of(node, c) {
                     Child::None => {}
                     Child::Leaf(start, len) => {
-                        for p in start..start + len {
-                            for &t in prims.of(&self.cw.primitive_indices[p as usize]) {
-                                let t = TriId(t);
-                                if t == rays.origin_tri || scene.tri_light[t.idx()] == Some(rays.light) {
-                                    continue;
-                                }
-                                fan.test_within(scene, rays, t, &mask[..w], out, ctx);
-                            }
-                        }
+                        self.test_leaf(prims, scene, rays, fan, (start, len), &mask[..w], out, ctx);
                         if fan.open()[word] & bit == 0 {
                             return fan.live() == 0;
                         }
@@ -260,6 +252,31 @@ impl Bvh {
             }
         }
         false
+    }
+
+    /// The triangles of the BVH leaf `(start, len)` (in the primitive indices) but the rays' own,
+    /// tested against the fan's open rays of `mask`.
+    #[allow(clippy::too_many_arguments)]
+    #[inline(always)]
+    fn test_leaf<P: Prims>(
+        &self,
+        prims: &P,
+        scene: &Scene,
+        rays: &LightRays,
+        fan: &mut Fan,
+        (start, len): (u32, u32),
+        mask: &[u64],
+        out: &mut [bool],
+        ctx: &mut QueryCtx,
+    ) {
+        for p in start..start + len {
+            for &t in prims.of(&self.cw.primitive_indices[p as usize]) {
+                let t = TriId(t);
+                if !rays.own(scene, t) {
+                    fan.test_within(scene, rays, t, mask, out, ctx);
+                }
+            }
+        }
     }
 
     /// The children `hit` of a visit (child `c` leading to `child_of(c)`, its box `los`/`his`
@@ -289,15 +306,7 @@ impl Bvh {
             match child_of(child) {
                 Child::None => {}
                 Child::Leaf(start, len) => {
-                    for p in start..start + len {
-                        for &t in prims.of(&self.cw.primitive_indices[p as usize]) {
-                            let t = TriId(t);
-                            if t == rays.origin_tri || scene.tri_light[t.idx()] == Some(rays.light) {
-                                continue;
-                            }
-                            fan.test_within(scene, rays, t, mask, out, ctx);
-                        }
-                    }
+                    self.test_leaf(prims, scene, rays, fan, (start, len), mask, out, ctx);
                     if fan.live() == 0 {
                         return true;
                     }

@@ -476,7 +476,7 @@ impl LightScratch {
             // (A scratch used with another scene may name triangles this one lacks.)
             let Some(tri) = scene.triangles.get(t as usize) else { break };
             let t = TriId(t);
-            if t == rays.origin_tri || scene.tri_light[t.idx()] == Some(rays.light) {
+            if rays.own(scene, t) {
                 continue;
             }
             if !self.fan.pyramid.culls(tri) {

@@ -237,7 +237,7 @@ impl LieVisibility<'_> {
             fn chunk(&mut self, tris: &[TriId], _: usize) -> bool {
                 let (vis, rays) = (self.vis, self.rays);
                 tris.iter().any(|&t| {
-                    if t == rays.origin_tri || vis.scene.tri_light[t.idx()] == Some(rays.light) {
+                    if rays.own(vis.scene, t) {
                         return false;
                     }
                     self.ctx.stats.box_tests += 1;
@@ -264,10 +264,7 @@ impl LieVisibility<'_> {
             if fan.live() == 0 {
                 return;
             }
-            if t == rays.origin_tri
-                || self.scene.tri_light[t.idx()] == Some(rays.light)
-                || (once && !ctx.first_visit(t))
-            {
+            if rays.own(self.scene, t) || (once && !ctx.first_visit(t)) {
                 continue;
             }
             ctx.stats.box_tests += 1;
