@@ -64,7 +64,13 @@ impl LightRays<'_> {
     /// point lies on and the light's.
     #[inline(always)]
     pub fn own(&self, scene: &Scene, t: TriId) -> bool {
-        t == self.origin_tri || scene.tri_light[t.idx()] == Some(self.light)
+        self.own_with(t, scene.tri_light[t.idx()])
+    }
+
+    /// [`LightRays::own`] for triangle `t` of light `light` (the scene's `tri_light[t]`).
+    #[inline(always)]
+    pub fn own_with(&self, t: TriId, light: Option<LightId>) -> bool {
+        t == self.origin_tri || light == Some(self.light)
     }
 
     /// The `k`-th shadow ray.

@@ -10,16 +10,31 @@ use rayon::prelude::*;
 /// BVH primitive. Two is common (both halves of an axis-aligned rectangle share their box), more rare.
 pub const CROWD_LIMIT: usize = 8;
 
-/// The triangles of each BVH primitive `p`: `tris[starts[p]..starts[p + 1]]`.
+/// The triangles of each BVH primitive `p`: `tris[starts[p]..starts[p + 1]]`; and, once the BVH
+/// is built ([`Groups::place`]), where the triangles of the primitive at each position of the BVH's
+/// primitive index array begin in the leaf-ordered copy ([`super::LeafTris`]).
 pub(super) struct Groups {
     starts: Vec<u32>,
     tris: Vec<u32>,
+    placed: Vec<u32>,
 }
 
 impl Groups {
     /// Bytes held.
     pub(super) fn memory_bytes(&self) -> usize {
-        (self.starts.len() + self.tris.len()) * 4
+        (self.starts.len() + self.tris.len() + self.placed.len()) * 4
+    }
+
+    /// Notes where the triangles of each position of `primitive_indices` begin when laid out in
+    /// that order (and where the last ends).
+    pub(super) fn place(&mut self, primitive_indices: &[u32]) {
+        self.placed = Vec::with_capacity(primitive_indices.len() + 1);
+        let mut at = 0u32;
+        for p in primitive_indices {
+            self.placed.push(at);
+            at += self.of(p).len() as u32;
+        }
+        self.placed.push(at);
     }
 }
 
@@ -28,6 +43,10 @@ impl Groups {
 pub(super) trait Prims {
     /// The triangles of primitive `*p` (`p` points into the BVH's primitive index array).
     fn of<'a>(&'a self, p: &'a u32) -> &'a [u32];
+
+    /// The range of the leaf-ordered triangles ([`super::LeafTris`]) of the primitives at
+    /// positions `start..start + len` of the BVH's primitive index array.
+    fn span(&self, start: u32, len: u32) -> std::ops::Range<usize>;
 }
 
 /// Every primitive is the triangle of the same index.
@@ -38,12 +57,22 @@ impl Prims for Single {
     fn of<'a>(&'a self, p: &'a u32) -> &'a [u32] {
         std::slice::from_ref(p)
     }
+
+    #[inline(always)]
+    fn span(&self, start: u32, len: u32) -> std::ops::Range<usize> {
+        start as usize..(start + len) as usize
+    }
 }
 
 impl Prims for Groups {
     #[inline(always)]
     fn of<'a>(&'a self, p: &'a u32) -> &'a [u32] {
         &self.tris[self.starts[*p as usize] as usize..self.starts[*p as usize + 1] as usize]
+    }
+
+    #[inline(always)]
+    fn span(&self, start: u32, len: u32) -> std::ops::Range<usize> {
+        self.placed[start as usize] as usize..self.placed[(start + len) as usize] as usize
     }
 }
 
@@ -99,5 +128,5 @@ pub(super) fn group_crowded_centres(boxes: &[BAabb], size: f32, pad: f32) -> Opt
         tris.extend(m);
         starts.push(tris.len() as u32);
     }
-    Some((prim_boxes, Groups { starts, tris }))
+    Some((prim_boxes, Groups { starts, tris, placed: Vec::new() }))
 }

@@ -316,7 +316,7 @@ mod tests {
             for (k, from) in [Some(&cut), None].into_iter().enumerate() {
                 fan.set(&rays);
                 fan.pyramid.set_in(&scene, x, rays.light);
-                bvh.fan_occluded(from, &scene, &rays, &mut fan, &mut walk, &mut answers[k], &mut ctx);
+                bvh.fan_occluded(from, &rays, &mut fan, &mut walk, &mut answers[k], &mut ctx);
             }
             assert_eq!(answers[0], answers[1], "cut against root");
             for (k, &a) in answers[0].iter().enumerate() {

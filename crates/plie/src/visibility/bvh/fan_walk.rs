@@ -28,15 +28,14 @@ use glam::{Vec3, Vec3A};
 use obvhs::cwbvh::node::CwBvhNode;
 
 use super::crowd::{Prims, Single};
-use super::cut::{Child, Cut};
-use super::Bvh;
-use crate::scene::{Scene, TriId};
+use super::cut::{Child, Cut, CUT_MAX};
+use super::{Bvh, LeafTris};
 use crate::visibility::fan::{nonzero_bytes, Fan, WalkStack};
 use crate::visibility::{LightRays, QueryCtx};
 
 impl Bvh {
-    /// Tests the fan's open rays against every triangle of `scene` (but each ray's own: the
-    /// origin triangle and the light's), walking the BVH with all of them at once, from `cut` (see
+    /// Tests the fan's open rays against every triangle of the scene the BVH was built from (but
+    /// each ray's own: the origin triangle and the light's), walking the BVH with all of them at once, from `cut` (see
     /// [`Bvh::cut_of`]: the cut of a region that holds every segment of the fan) or else from the
     /// root. Each ray a triangle blocks gets `out[k]` set and is closed in the fan. The caller has
     /// set the fan's pyramid for this light.
@@ -44,7 +43,6 @@ impl Bvh {
     pub(crate) fn fan_occluded(
         &self,
         cut: Option<&Cut>,
-        scene: &Scene,
         rays: &LightRays,
         fan: &mut Fan,
         walk: &mut WalkStack,
@@ -57,9 +55,9 @@ impl Bvh {
             && std::arch::is_x86_feature_detected!("bmi1")
         {
             // SAFETY: AVX2, POPCNT and BMI1 are available (checked above).
-            return unsafe { self.fan_occluded_avx(cut, scene, rays, fan, walk, out, ctx) };
+            return unsafe { self.fan_occluded_avx(cut, rays, fan, walk, out, ctx) };
         }
-        self.fan_occluded_in(cut, scene, rays, fan, walk, out, ctx)
+        self.fan_occluded_in(cut, rays, fan, walk, out, ctx)
     }
 
     /// [`Bvh::fan_occluded`] compiled for AVX2 as a whole, so that the lane kernels (AVX2
@@ -72,14 +70,13 @@ impl Bvh {
     unsafe fn fan_occluded_avx(
         &self,
         cut: Option<&Cut>,
-        scene: &Scene,
         rays: &LightRays,
         fan: &mut Fan,
         walk: &mut WalkStack,
         out: &mut [bool],
         ctx: &mut QueryCtx,
     ) {
-        self.fan_occluded_in(cut, scene, rays, fan, walk, out, ctx)
+        self.fan_occluded_in(cut, rays, fan, walk, out, ctx)
     }
 
     /// [`Bvh::fan_occluded`] for the BVH's kind of leaves.
@@ -88,7 +85,6 @@ impl Bvh {
     fn fan_occluded_in(
         &self,
         cut: Option<&Cut>,
-        scene: &Scene,
         rays: &LightRays,
         fan: &mut Fan,
         walk: &mut WalkStack,
@@ -98,10 +94,10 @@ impl Bvh {
         // Up to 64 rays (one word of mask, the usual case) with the word count known to the
         // compiler.
         match (&self.groups, fan.words() == 1) {
-            (None, true) => self.fan_walk::<_, true>(cut, &Single, scene, rays, fan, walk, out, ctx),
-            (None, false) => self.fan_walk::<_, false>(cut, &Single, scene, rays, fan, walk, out, ctx),
-            (Some(g), true) => self.fan_walk::<_, true>(cut, g, scene, rays, fan, walk, out, ctx),
-            (Some(g), false) => self.fan_walk::<_, false>(cut, g, scene, rays, fan, walk, out, ctx),
+            (None, true) => self.fan_walk::<_, true>(cut, &Single, rays, fan, walk, out, ctx),
+            (None, false) => self.fan_walk::<_, false>(cut, &Single, rays, fan, walk, out, ctx),
+            (Some(g), true) => self.fan_walk::<_, true>(cut, g, rays, fan, walk, out, ctx),
+            (Some(g), false) => self.fan_walk::<_, false>(cut, g, rays, fan, walk, out, ctx),
         }
     }
 
@@ -111,7 +107,6 @@ impl Bvh {
         &self,
         cut: Option<&Cut>,
         prims: &P,
-        scene: &Scene,
         rays: &LightRays,
         fan: &mut Fan,
         walk: &mut WalkStack,
@@ -136,49 +131,43 @@ impl Bvh {
                 masks.extend_from_slice(fan.open());
             }
             Some(cut) => {
-                // The cut's entries as the children of one node per eight, their boxes made
-                // relative to the apex.
-                for first in (0..cut.len as usize).step_by(8) {
-                    let n = (cut.len as usize - first).min(8);
-                    let (mut los, mut his) = ([[0f32; 8]; 3], [[0f32; 8]; 3]);
-                    for k in 0..3 {
-                        for c in 0..n {
-                            los[k][c] = (cut.lo[k][first + c] - apex[k]) * to_world;
-                            his[k][c] = (cut.hi[k][first + c] - apex[k]) * to_world;
-                        }
+                // The cut's entries as the children of one node, their boxes made relative to the
+                // apex (all eight lanes, so that the loop is one of vectors: the lanes past the
+                // cut's length are not `filled`).
+                let (mut los, mut his) = ([[0f32; 8]; 3], [[0f32; 8]; 3]);
+                for k in 0..3 {
+                    for c in 0..CUT_MAX {
+                        los[k][c] = (cut.lo[k][c] - apex[k]) * to_world;
+                        his[k][c] = (cut.hi[k][c] - apex[k]) * to_world;
                     }
-                    let culled = fan.pyramid.culls_rel8(&los, &his);
-                    let filled = ((1u16 << n) - 1) as u8;
-                    node_mask.clear();
-                    node_mask.extend_from_slice(fan.open());
-                    let hit = fan.meets8(&los, &his, filled & !culled, &node_mask[..w], &mut child_masks[..8 * w], ctx);
-                    let at = (hit, &los, &his, |c: usize| cut.child[first + c]);
-                    if self.take_children::<P, ONE>(
-                        prims,
-                        scene,
-                        rays,
-                        fan,
-                        out,
-                        ctx,
-                        at,
-                        toward,
-                        nodes,
-                        masks,
-                        child_masks,
-                    ) {
-                        return;
-                    }
+                }
+                let culled = fan.pyramid.culls_rel8(&los, &his);
+                let filled = ((1u16 << cut.len) - 1) as u8;
+                node_mask.clear();
+                node_mask.extend_from_slice(fan.open());
+                let hit = fan.meets8(&los, &his, filled & !culled, &node_mask[..w], &mut child_masks[..8 * w], ctx);
+                let at = (hit, &los, &his, |c: usize| cut.child[c]);
+                if self.take_children::<P, ONE>(prims, rays, fan, out, ctx, at, toward, nodes, masks, child_masks) {
+                    return;
                 }
             }
         }
         while let Some(ni) = nodes.pop() {
-            let at = masks.len() - w;
-            // Word by word: masks are one or two words, too short for a copy call.
-            node_mask.clear();
-            for &m in &masks[at..at + w] {
-                node_mask.push(m);
-            }
-            masks.truncate(at);
+            // One word of mask (up to 64 rays) is kept in a register, more in the scratch.
+            let mut word = [0u64; 1];
+            let node_mask: &[u64] = if ONE {
+                word[0] = masks.pop().unwrap_or(0);
+                &word
+            } else {
+                let at = masks.len() - w;
+                // Word by word: masks are one or two words, too short for a copy call.
+                node_mask.clear();
+                for &m in &masks[at..at + w] {
+                    node_mask.push(m);
+                }
+                masks.truncate(at);
+                node_mask
+            };
             // Its rays may all have been closed since it was pushed; one ray left walks alone.
             let count: u32 = node_mask.iter().zip(fan.open()).map(|(m, o)| (m & o).count_ones()).sum();
             if count == 0 {
@@ -188,7 +177,7 @@ impl Bvh {
                 let word = node_mask.iter().zip(fan.open()).position(|(m, o)| m & o != 0).unwrap_or(0);
                 let k = word * 64 + (node_mask[word] & fan.open()[word]).trailing_zeros() as usize;
                 let at = (ni, k, apex, to_world);
-                if self.ray_walk::<P, ONE>(prims, scene, rays, fan, out, ctx, at, ray_nodes, ray_mask) {
+                if self.ray_walk::<P, ONE>(prims, rays, fan, out, ctx, at, ray_nodes, ray_mask) {
                     return;
                 }
                 continue;
@@ -200,7 +189,7 @@ impl Bvh {
             let filled = nonzero_bytes(u64::from_le_bytes(node.child_meta));
             let hit = fan.meets8(&los, &his, filled & !culled, &node_mask[..w], &mut child_masks[..8 * w], ctx);
             let at = (hit, &los, &his, |c: usize| Child::of(node, c));
-            if self.take_children::<P, ONE>(prims, scene, rays, fan, out, ctx, at, toward, nodes, masks, child_masks) {
+            if self.take_children::<P, ONE>(prims, rays, fan, out, ctx, at, toward, nodes, masks, child_masks) {
                 return;
             }
         }
@@ -215,7 +204,6 @@ impl Bvh {
     fn ray_walk<P: Prims, const ONE: bool>(
         &self,
         prims: &P,
-        scene: &Scene,
         rays: &LightRays,
         fan: &mut Fan,
         out: &mut [bool],
@@ -242,7 +230,7 @@ impl Bvh {
                 match Child::of(node, c) {
                     Child::None => {}
                     Child::Leaf(start, len) => {
-                        self.test_leaf(prims, scene, rays, fan, (start, len), &mask[..w], out, ctx);
+                        self.test_leaf(prims, rays, fan, (start, len), &mask[..w], out, ctx);
                         if fan.open()[word] & bit == 0 {
                             return fan.live() == 0;
                         }
@@ -255,13 +243,12 @@ impl Bvh {
     }
 
     /// The triangles of the BVH leaf `(start, len)` (in the primitive indices) but the rays' own,
-    /// tested against the fan's open rays of `mask`.
+    /// tested against the fan's open rays of `mask`, read from the leaf-ordered copy.
     #[allow(clippy::too_many_arguments)]
     #[inline(always)]
     fn test_leaf<P: Prims>(
         &self,
         prims: &P,
-        scene: &Scene,
         rays: &LightRays,
         fan: &mut Fan,
         (start, len): (u32, u32),
@@ -269,12 +256,11 @@ impl Bvh {
         out: &mut [bool],
         ctx: &mut QueryCtx,
     ) {
-        for p in start..start + len {
-            for &t in prims.of(&self.cw.primitive_indices[p as usize]) {
-                let t = TriId(t);
-                if !rays.own(scene, t) {
-                    fan.test_within(scene, rays, t, mask, out, ctx);
-                }
+        let LeafTris { tris, ids, lights } = &self.leaf_tris;
+        let span = prims.span(start, len);
+        for ((tri, &t), &light) in tris[span.clone()].iter().zip(&ids[span.clone()]).zip(&lights[span]) {
+            if !rays.own_with(t, light) {
+                fan.test_within(tri, t, rays, mask, out, ctx);
             }
         }
     }
@@ -287,7 +273,6 @@ impl Bvh {
     fn take_children<P: Prims, const ONE: bool>(
         &self,
         prims: &P,
-        scene: &Scene,
         rays: &LightRays,
         fan: &mut Fan,
         out: &mut [bool],
@@ -301,12 +286,15 @@ impl Bvh {
         let w = if ONE { 1 } else { fan.words() };
         let mut pending = [(0f32, 0u32, 0usize); 8];
         let mut count = 0;
-        for child in (0..8).filter(|c| hit >> c & 1 != 0) {
+        let mut rest = hit;
+        while rest != 0 {
+            let child = rest.trailing_zeros() as usize;
+            rest &= rest - 1;
             let mask = &child_masks[child * w..(child + 1) * w];
             match child_of(child) {
                 Child::None => {}
                 Child::Leaf(start, len) => {
-                    self.test_leaf(prims, scene, rays, fan, (start, len), mask, out, ctx);
+                    self.test_leaf(prims, rays, fan, (start, len), mask, out, ctx);
                     if fan.live() == 0 {
                         return true;
                     }
@@ -324,9 +312,15 @@ impl Bvh {
         }
         if count > 0 {
             // Nearest last, so it is visited first.
-            let pending = &mut pending[..count];
-            pending.sort_unstable_by(|a, b| b.0.total_cmp(&a.0));
-            for &(_, n, slot) in pending.iter() {
+            // (Insertion, for at most eight.)
+            for i in 1..count {
+                let mut j = i;
+                while j > 0 && pending[j - 1].0.total_cmp(&pending[j].0).is_lt() {
+                    pending.swap(j - 1, j);
+                    j -= 1;
+                }
+            }
+            for &(_, n, slot) in &pending[..count] {
                 nodes.push(n);
                 for &m in &child_masks[slot * w..(slot + 1) * w] {
                     masks.push(m);
@@ -362,3 +356,6 @@ fn child_boxes(node: &CwBvhNode, apex: Vec3A, to_world: f32) -> ([[f32; 8]; 3], 
 /// cornell-dragon-100k and cornell-bunny, docs/results.md issue 21 session 25): 8 needed the fewest
 /// instructions of 0, 4, 8 and 16.
 const CULL_ABOVE: u32 = 8;
+
+// A cut's entries are tested as the children of one node.
+const _: () = assert!(CUT_MAX == 8);

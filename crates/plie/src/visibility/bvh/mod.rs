@@ -31,8 +31,8 @@ use obvhs::ray::Ray;
 use obvhs::BvhBuildParams;
 
 use super::{blocks, LightRays, QueryCtx, ShadowRay, Visibility};
-use crate::geometry::RayTest;
-use crate::scene::{Scene, TriId};
+use crate::geometry::{RayTest, Triangle};
+use crate::scene::{LightId, Scene, TriId};
 pub use crowd::CROWD_LIMIT;
 use crowd::{group_crowded_centres, Groups, Prims, Single};
 
@@ -63,6 +63,38 @@ pub struct Bvh {
     /// The triangles of each primitive when some centres were crowded ([`CROWD_LIMIT`]); else every
     /// primitive is the triangle of the same index.
     groups: Option<Groups>,
+    /// The triangles in the order of the leaves, for the fans' walks.
+    leaf_tris: LeafTris,
+}
+
+/// A copy of the scene's triangles in the order the BVH's leaves list them (the primitives of the
+/// primitive index array, each one's triangles in turn), with their ids and lights: a leaf's
+/// triangles lie side by side in memory, as the fans' walks read them ([`Prims::span`]).
+#[derive(Default)]
+struct LeafTris {
+    tris: Vec<Triangle>,
+    ids: Vec<TriId>,
+    lights: Vec<Option<LightId>>,
+}
+
+impl LeafTris {
+    fn of<P: Prims>(scene: &Scene, primitive_indices: &[u32], prims: &P) -> LeafTris {
+        let mut out = LeafTris::default();
+        for p in primitive_indices {
+            for &t in prims.of(p) {
+                out.tris.push(scene.triangles[t as usize]);
+                out.ids.push(TriId(t));
+                out.lights.push(scene.tri_light[t as usize]);
+            }
+        }
+        out
+    }
+
+    fn memory_bytes(&self) -> usize {
+        self.tris.len() * std::mem::size_of::<Triangle>()
+            + self.ids.len() * std::mem::size_of::<TriId>()
+            + self.lights.len() * std::mem::size_of::<Option<LightId>>()
+    }
 }
 
 /// Calls `$f($stack, $prims, args...)` with the traversal stack and primitive kind `$bvh` needs.
@@ -105,10 +137,18 @@ impl Bvh {
             .collect();
         let (cw, groups) = match group.then(|| group_crowded_centres(&boxes, NORMALISED_SIZE, PAD)).flatten() {
             None => (build_cwbvh(&boxes, BvhBuildParams::medium_build()), None),
-            Some((prim_boxes, groups)) => (build_cwbvh(&prim_boxes, BvhBuildParams::medium_build()), Some(groups)),
+            Some((prim_boxes, mut groups)) => {
+                let cw = build_cwbvh(&prim_boxes, BvhBuildParams::medium_build());
+                groups.place(&cw.primitive_indices);
+                (cw, Some(groups))
+            }
+        };
+        let leaf_tris = match &groups {
+            None => LeafTris::of(scene, &cw.primitive_indices, &Single),
+            Some(g) => LeafTris::of(scene, &cw.primitive_indices, g),
         };
         let depth = inner_depth(&cw);
-        Bvh { cw, origin, scale, depth, groups }
+        Bvh { cw, origin, scale, depth, groups, leaf_tris }
     }
 
     /// Number of BVH primitives (triangles, or groups of triangles with crowded centres).
@@ -130,7 +170,10 @@ impl Bvh {
     /// Bytes used by the nodes and index array.
     pub fn memory_bytes(&self) -> usize {
         let groups = self.groups.as_ref().map_or(0, Groups::memory_bytes);
-        self.cw.nodes.len() * std::mem::size_of_val(&self.cw.nodes[0]) + self.cw.primitive_indices.len() * 4 + groups
+        self.cw.nodes.len() * std::mem::size_of_val(&self.cw.nodes[0])
+            + self.cw.primitive_indices.len() * 4
+            + groups
+            + self.leaf_tris.memory_bytes()
     }
 
     fn to_local(&self, p: Vec3) -> Vec3A {
@@ -229,7 +272,7 @@ impl Visibility for BvhVisibility<'_> {
             sc.fan.pyramid.set_in(self.scene, rays.origin, rays.light);
             sc.test_last_blockers(self.scene, rays, out, ctx);
             if sc.fan.live() > 0 {
-                self.bvh.fan_occluded(None, self.scene, rays, &mut sc.fan, &mut sc.walk, out, ctx);
+                self.bvh.fan_occluded(None, rays, &mut sc.fan, &mut sc.walk, out, ctx);
             }
             sc.keep_blockers(rays);
         });

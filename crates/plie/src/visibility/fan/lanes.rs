@@ -7,6 +7,8 @@
 use glam::Vec3;
 
 use super::LANES;
+#[cfg(target_arch = "x86_64")]
+use crate::geometry::Triangle;
 use crate::geometry::SEGMENT_EPS;
 
 /// The inverse of a direction's component for the slab test, with a non-finite one (of a zero or
@@ -424,7 +426,9 @@ pub(super) unsafe fn meets_boxes_by_ray_avx(
     }
 }
 
-/// [`meets_boxes`] in one call with AVX2, each box by [`meets_box_avx`].
+/// [`meets_boxes`] in one call with AVX2: per block of eight lanes with a bit in `within`, its
+/// inverse directions loaded once and tested against each box of `alive` by [`slab_avx`], as
+/// [`meets_box_avx`] tests them.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx,avx2")]
 #[inline]
@@ -437,8 +441,37 @@ unsafe fn meets_boxes_avx(
     within: u64,
     out: &mut [u64; 8],
 ) {
-    // SAFETY: the caller's guarantees.
-    each_box(lo, hi, alive, out, |l, h| unsafe { meets_box_avx(l, h, lanes, base, within) });
+    use std::arch::x86_64::*;
+    *out = [0; 8];
+    let n = lanes.ix.len().min(lanes.iy.len()).min(lanes.iz.len());
+    let mut rest = within;
+    while rest != 0 {
+        let at = rest.trailing_zeros() as usize / LANES * LANES;
+        let byte = rest >> at & 0xff;
+        rest &= !(0xff << at);
+        let j = base + at;
+        if j + LANES > n {
+            continue;
+        }
+        // SAFETY: j + LANES <= n <= every array's length; AVX2 is enabled here.
+        let inv = unsafe {
+            [
+                _mm256_loadu_ps(lanes.ix.as_ptr().add(j)),
+                _mm256_loadu_ps(lanes.iy.as_ptr().add(j)),
+                _mm256_loadu_ps(lanes.iz.as_ptr().add(j)),
+            ]
+        };
+        let mut boxes = alive;
+        while boxes != 0 {
+            let c = boxes.trailing_zeros() as usize;
+            boxes &= boxes - 1;
+            let sp = |v: f32| _mm256_set1_ps(v);
+            let (l, h) = ([sp(lo[0][c]), sp(lo[1][c]), sp(lo[2][c])], [sp(hi[0][c]), sp(hi[1][c]), sp(hi[2][c])]);
+            // SAFETY: AVX2 is enabled here.
+            let m = u64::from(unsafe { slab_avx(l, h, inv) });
+            out[c] |= (m & byte) << at;
+        }
+    }
 }
 
 /// [`meets_box`], eight lanes at a time (blocks of lanes with no bit in `within` are skipped).
@@ -550,7 +583,9 @@ unsafe fn misses_avx(s: &[Vec3; 3], span: &[(f32, f32); 3], lanes: &Lanes, maybe
     let (s1x, s1y, s1z) = (sp(s[1].x), sp(s[1].y), sp(s[1].z));
     let (s2x, s2y, s2z) = (sp(s[2].x), sp(s[2].y), sp(s[2].z));
     let sign = sp(-0.0);
-    let (lo, hi) = (span.map(|s| sp(s.0)), span.map(|s| sp(s.1)));
+    // The spans' bounds in lanes 0-2, picked per lane by one permutation of lanes.
+    let xyz = |v: [f32; 3]| _mm256_castps128_ps256(_mm_setr_ps(v[0], v[1], v[2], 0.0));
+    let (lo, hi) = (xyz(span.map(|s| s.0)), xyz(span.map(|s| s.1)));
     let (t_min, t_max, t_margin) = (sp(SEGMENT_EPS), sp(1.0 - SEGMENT_EPS), sp(T_MARGIN));
     maybe.fill(0);
     let mut j = 0;
@@ -583,8 +618,7 @@ unsafe fn misses_avx(s: &[Vec3; 3], span: &[(f32, f32); 3], lanes: &Lanes, maybe
                 (_mm256_loadu_ps(lanes.sz.as_ptr().add(j)), _mm256_loadu_si256(lanes.kz.as_ptr().add(j).cast()))
             };
             // The span along each lane's own axis.
-            // SAFETY: AVX2 is enabled here.
-            let (lo, hi) = unsafe { (by_axis(kz, lo), by_axis(kz, hi)) };
+            let (lo, hi) = (_mm256_permutevar8x32_ps(lo, kz), _mm256_permutevar8x32_ps(hi, kz));
             let (z1, z2) = (_mm256_mul_ps(lo, sz), _mm256_mul_ps(hi, sz));
             let (zlo, zhi) = (_mm256_min_ps(z1, z2), _mm256_max_ps(z1, z2));
             let abs = |v| _mm256_andnot_ps(sign, v);
@@ -606,15 +640,31 @@ pub(super) struct Shear<'a> {
     pub(super) k: [&'a [u32]; 3],
 }
 
-/// [`crate::geometry::RayTest::hit`] of the triangle with vertices `a`, `b`, `c` (relative to the
-/// rays' common origin) for the eight lanes `base..base + 8`, with `t` in
+/// The vertices of `tri` relative to `x` (as `Vec3`'s subtraction), each in lanes 0-2 of a vector
+/// (lane 3 unused), loaded straight from the triangle's nine floats.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx,avx2")]
+#[inline]
+pub(super) fn vertices_rel(tri: &Triangle, x: Vec3) -> [std::arch::x86_64::__m128; 3] {
+    use std::arch::x86_64::*;
+    let p = tri.v.as_ptr().cast::<f32>();
+    // SAFETY: `tri.v` is nine contiguous floats; each load reads four of them.
+    let (v0, v1, t) = unsafe { (_mm_loadu_ps(p), _mm_loadu_ps(p.add(3)), _mm_loadu_ps(p.add(5))) };
+    // (z1, x2, y2, z2) -> (x2, y2, z2, z1).
+    let v2 = _mm_shuffle_ps::<0b00_11_10_01>(t, t);
+    let xv = _mm_setr_ps(x.x, x.y, x.z, 0.0);
+    [_mm_sub_ps(v0, xv), _mm_sub_ps(v1, xv), _mm_sub_ps(v2, xv)]
+}
+
+/// [`crate::geometry::RayTest::hit`] of the triangle with vertices `v` (relative to the rays'
+/// common origin, in lanes 0-2: [`vertices_rel`]) for the eight lanes `base..base + 8`, with `t` in
 /// `(SEGMENT_EPS, 1 - SEGMENT_EPS)`: the same IEEE operations in the same order, so the same answers.
 /// Returns the lanes hit and the lanes the scalar test must decide (an edge function exactly zero,
 /// which it recomputes in f64), as bits.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx,avx2")]
 #[inline]
-pub(super) unsafe fn exact_avx(a: Vec3, b: Vec3, c: Vec3, shear: &Shear, base: usize) -> (u8, u8) {
+pub(super) unsafe fn exact_avx(v: [std::arch::x86_64::__m128; 3], shear: &Shear, base: usize) -> (u8, u8) {
     use std::arch::x86_64::*;
     let n = shear.s.iter().map(|v| v.len()).chain(shear.k.iter().map(|v| v.len())).min().unwrap_or(0);
     assert!(base + LANES <= n, "lanes {base}.. of {n}");
@@ -630,9 +680,10 @@ pub(super) unsafe fn exact_avx(a: Vec3, b: Vec3, c: Vec3, shear: &Shear, base: u
         )
     };
     let sp = |v: f32| _mm256_set1_ps(v);
-    // Per lane, component `k` of `v`.
-    // SAFETY: AVX2 is enabled here.
-    let pick = |v: Vec3, k: __m256i| unsafe { by_axis(k, [sp(v.x), sp(v.y), sp(v.z)]) };
+    // Per lane, component `k` of `v` (lanes 0-2 of `v`), by one permutation of lanes: the
+    // value itself, moved.
+    let (a, b, c) = (_mm256_castps128_ps256(v[0]), _mm256_castps128_ps256(v[1]), _mm256_castps128_ps256(v[2]));
+    let pick = |v: __m256, k: __m256i| _mm256_permutevar8x32_ps(v, k);
     let (mul, sub, add) = (|x, y| _mm256_mul_ps(x, y), |x, y| _mm256_sub_ps(x, y), |x, y| _mm256_add_ps(x, y));
     let (akz, bkz, ckz) = (pick(a, kz), pick(b, kz), pick(c, kz));
     let ax = sub(pick(a, kx), mul(sx, akz));
@@ -850,7 +901,7 @@ mod tests {
     fn lane_watertight_test_matches_the_scalar_one() {
         #[cfg(target_arch = "x86_64")]
         if std::arch::is_x86_feature_detected!("avx2") {
-            use crate::geometry::{RayTest, Triangle};
+            use crate::geometry::RayTest;
             let mut rng = crate::render::sampler::Rng::stream(9, 0, 0, 0);
             let mut v =
                 || Vec3::new(rng.next_f32() * 4.0 - 2.0, rng.next_f32() * 4.0 - 2.0, rng.next_f32() * 4.0 - 2.0);
@@ -887,9 +938,8 @@ mod tests {
                     }
                 }
                 let shear = Shear { s: [&s[0], &s[1], &s[2]], k: [&k[0], &k[1], &k[2]] };
-                let (a, b, c) = (tri.v[0] - x, tri.v[1] - x, tri.v[2] - x);
                 // SAFETY: AVX2 is available (checked above); eight lanes.
-                let (hit, to_scalar) = unsafe { exact_avx(a, b, c, &shear, 0) };
+                let (hit, to_scalar) = unsafe { exact_avx(vertices_rel(&tri, x), &shear, 0) };
                 for (j, t) in tests.iter().enumerate() {
                     total += 1;
                     if to_scalar >> j & 1 != 0 {

@@ -36,7 +36,7 @@ mod lanes;
 #[cfg(target_arch = "x86_64")]
 use lanes::fan_lanes_avx;
 #[cfg(target_arch = "x86_64")]
-use lanes::{exact_avx, Shear};
+use lanes::{exact_avx, vertices_rel, Shear};
 use lanes::{inverse, meets_boxes, misses, ray_meets_boxes, shear_lanes, BoxLanes, Lanes};
 
 /// Relative margin of the edge functions. The watertight test's sheared edge function of an edge
@@ -225,8 +225,8 @@ impl Fan {
         let mut hits = 0u64;
         #[cfg(target_arch = "x86_64")]
         if std::arch::is_x86_feature_detected!("avx2") {
-            let x = self.origin;
-            let (a, b, c) = (tri.v[0] - x, tri.v[1] - x, tri.v[2] - x);
+            // SAFETY: AVX2 is available (checked above).
+            let v = unsafe { vertices_rel(tri, self.origin) };
             let [sx, sy] = &self.shear_s;
             let [kx, ky] = &self.shear_k;
             let shear = Shear { s: [sx, sy, &self.all[4]], k: [kx, ky, &self.all_kz] };
@@ -239,12 +239,14 @@ impl Fan {
                 rest &= !(0xff << at);
                 // SAFETY: AVX2 is available (checked above); the shear lanes are padded to whole
                 // blocks.
-                let (hit, scalar) = unsafe { exact_avx(a, b, c, &shear, w * 64 + at) };
+                let (hit, scalar) = unsafe { exact_avx(v, &shear, w * 64 + at) };
                 hits |= (u64::from(hit) & byte) << at;
                 one_by_one |= (u64::from(scalar) & byte) << at;
             }
         }
-        self.build(w, one_by_one, rays);
+        if one_by_one != 0 {
+            self.build(w, one_by_one, rays);
+        }
         while one_by_one != 0 {
             let i = one_by_one.trailing_zeros() as usize;
             one_by_one &= one_by_one - 1;
@@ -334,19 +336,20 @@ impl Fan {
         ray_meets_boxes(lo, hi, alive, &BoxLanes { ix, iy, iz }, k)
     }
 
-    /// [`Fan::test`] for the open lanes of `within` only: up to [`DIRECT_MAX`] lanes go straight to
-    /// the watertight test, more first through the eight-lane edge test.
+    /// [`Fan::test`] of triangle `t`, given as `tri` (the scene's or a copy of it), for the open
+    /// lanes of `within` only: up to [`DIRECT_MAX`] lanes go straight to the watertight test, more
+    /// first through the eight-lane edge test.
     #[inline]
-    pub fn test_within(
+    pub(crate) fn test_within(
         &mut self,
-        scene: &Scene,
-        rays: &LightRays,
+        tri: &Triangle,
         t: TriId,
+        rays: &LightRays,
         within: &[u64],
         out: &mut [bool],
         ctx: &mut QueryCtx,
     ) {
-        self.test_masked(scene, rays, t, Some(within), out, ctx);
+        self.test_masked(tri, t, rays, Some(within), out, ctx);
     }
 
     /// Rays not yet found occluded.
@@ -361,7 +364,7 @@ impl Fan {
     /// test. The caller has excluded the rays' own triangles (the origin's and the light's).
     #[inline]
     pub fn test(&mut self, scene: &Scene, rays: &LightRays, t: TriId, out: &mut [bool], ctx: &mut QueryCtx) {
-        self.test_masked(scene, rays, t, None, out, ctx);
+        self.test_masked(&scene.triangles[t.idx()], t, rays, None, out, ctx);
     }
 
     /// [`Fan::test`], for the open lanes of `within` only when given: up to [`DIRECT_MAX`] of them
@@ -369,14 +372,13 @@ impl Fan {
     #[inline(always)]
     fn test_masked(
         &mut self,
-        scene: &Scene,
-        rays: &LightRays,
+        tri: &Triangle,
         t: TriId,
+        rays: &LightRays,
         within: Option<&[u64]>,
         out: &mut [bool],
         ctx: &mut QueryCtx,
     ) {
-        let tri = &scene.triangles[t.idx()];
         let mask = |w: usize| within.map_or(u64::MAX, |m| m[w]);
         // The words of the mask (from `within` where given, so a caller that knows it lets the
         // compiler know).

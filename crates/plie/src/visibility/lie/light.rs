@@ -122,7 +122,7 @@ impl LieVisibility<'_> {
             // The cut holds every triangle a segment from the leaf to the light can meet.
             debug_assert!(self.octree.leaf_bounds(leaf).expanded(self.scene.scale() * 1e-5).contains(rays.origin));
             let cut = self.cut(leaf, rays.light);
-            self.bvh.fan_occluded(cut, self.scene, rays, &mut sc.fan, &mut sc.walk, out, ctx);
+            self.bvh.fan_occluded(cut, rays, &mut sc.fan, &mut sc.walk, out, ctx);
         }
         sc.keep_blockers(rays);
         ctx.stats.blocker_tests += ctx.stats.triangle_tests - before;
