@@ -8,7 +8,7 @@
 //! [`CULL_ABOVE`] open rays, then each is tested against every ray still in the node's mask, eight
 //! rays at a time, or one ray against all eight boxes where the node's rays are few and spread out
 //! ([`Fan::meets8`]); a leaf's triangles are tested against the rays that met its box
-//! ([`Fan::test_within`]). Inner children are visited nearest first (along the first sample's
+//! ([`Fan::test_within`], read from the BVH's leaf-ordered copy of the triangles). Inner children are visited nearest first (along the first sample's
 //! direction), so that blockers close the rays early. A node left with one open ray is walked by
 //! that ray alone ([`Bvh::ray_walk`]): a slab test of the ray against the eight child boxes per
 //! node, with no masks to keep. The P-LIE modes start below the root, from the cut of the point's
