@@ -7,12 +7,13 @@
 //! ([`crate::visibility::pyramid::Pyramid::culls_rel8`]) where the node has more than
 //! [`CULL_ABOVE`] open rays, then each is tested against every ray still in the node's mask, eight
 //! rays at a time, or one ray against all eight boxes where the node's rays are few and spread out
-//! ([`Fan::meets8`]); a leaf's triangles are tested against the rays that met its box
-//! ([`Fan::test_within`], read from the BVH's leaf-ordered copy of the triangles). Inner children are visited nearest first (along the first sample's
-//! direction), so that blockers close the rays early. A node left with one open ray is walked by
-//! that ray alone ([`Bvh::ray_walk`]): a slab test of the ray against the eight child boxes per
-//! node, with no masks to keep. The P-LIE modes start below the root, from the cut of the point's
-//! leaf and the light ([`super::cut`]), whose entries are tested as the children of one node.
+//! ([`Fan::meets8`]); a leaf's triangles (read from the BVH's copy of them in leaf order) are
+//! tested against the rays that met its box ([`Fan::test_within`]). Inner children are visited
+//! nearest first (along the first sample's direction), so that blockers close the rays early. A
+//! node left with one open ray is walked by that ray alone ([`Bvh::ray_walk`]): a slab test of the
+//! ray against the eight child boxes per node, with no masks to keep. The P-LIE modes start below
+//! the root, from the cut of the point's leaf and the light ([`super::cut`]), whose entries are
+//! tested as the children of one node.
 //!
 //! The boxes are the BVH's own (each triangle's box padded by `PAD` in its normalised space), taken
 //! back to world units relative to the fan's apex; the rounding of that is far below the padding, so
@@ -35,9 +36,9 @@ use crate::visibility::{LightRays, QueryCtx};
 
 impl Bvh {
     /// Tests the fan's open rays against every triangle of the scene the BVH was built from (but
-    /// each ray's own: the origin triangle and the light's), walking the BVH with all of them at once, from `cut` (see
-    /// [`Bvh::cut_of`]: the cut of a region that holds every segment of the fan) or else from the
-    /// root. Each ray a triangle blocks gets `out[k]` set and is closed in the fan. The caller has
+    /// each ray's own: the origin triangle and the light's), walking the BVH with all of them at
+    /// once, from `cut` (see [`Bvh::cut_of`]: the cut of a region that holds every segment of the
+    /// fan) or else from the root. Each ray a triangle blocks gets `out[k]` set and is closed in the fan. The caller has
     /// set the fan's pyramid for this light.
     #[allow(clippy::too_many_arguments)]
     pub(crate) fn fan_occluded(
