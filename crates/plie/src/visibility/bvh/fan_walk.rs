@@ -38,8 +38,8 @@ impl Bvh {
     /// Tests the fan's open rays against every triangle of the scene the BVH was built from (but
     /// each ray's own: the origin triangle and the light's), walking the BVH with all of them at
     /// once, from `cut` (see [`Bvh::cut_of`]: the cut of a region that holds every segment of the
-    /// fan) or else from the root. Each ray a triangle blocks gets `out[k]` set and is closed in the fan. The caller has
-    /// set the fan's pyramid for this light.
+    /// fan) or else from the root. Each ray a triangle blocks gets `out[k]` set and is closed in
+    /// the fan. The caller has set the fan's pyramid for this light.
     #[allow(clippy::too_many_arguments)]
     pub(crate) fn fan_occluded(
         &self,

@@ -172,7 +172,7 @@ impl Bvh {
         (self.depth as usize) < FIXED_STACK
     }
 
-    /// Bytes used by the nodes and index array.
+    /// Bytes used by the nodes, the index array, the crowds' groups and the leaf-ordered triangles.
     pub fn memory_bytes(&self) -> usize {
         let groups = self.groups.as_ref().map_or(0, Groups::memory_bytes);
         self.cw.nodes.len() * std::mem::size_of_val(&self.cw.nodes[0])

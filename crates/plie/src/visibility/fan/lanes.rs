@@ -267,14 +267,10 @@ pub(super) struct BoxLanes<'a> {
 
 /// The bits of `within` (the word of lanes `base..base + 64`) whose segments (origin at the
 /// fan's apex, parameter range `[SEGMENT_EPS, 1 - SEGMENT_EPS]`) meet the box `[lo, hi]` given
-/// relative to the apex.
+/// relative to the apex. Ray by ray: the test the box kernels ([`slab_avx`]) compute eight lanes
+/// wide, for CPUs without AVX2.
 #[inline]
 pub(super) fn meets_box(lo: Vec3, hi: Vec3, lanes: &BoxLanes, base: usize, within: u64) -> u64 {
-    #[cfg(target_arch = "x86_64")]
-    if std::arch::is_x86_feature_detected!("avx2") {
-        // SAFETY: AVX2 is available (checked above); the lane arrays are padded to whole blocks.
-        return unsafe { meets_box_avx(lo, hi, lanes, base, within) };
-    }
     let mut out = 0;
     let mut bits = within;
     while bits != 0 {
@@ -381,7 +377,7 @@ unsafe fn ray_meets_boxes_avx(lo: &[[f32; 8]; 3], hi: &[[f32; 8]; 3], alive: u8,
 
 /// [`meets_boxes`] with the eight boxes in lanes and one ray at a time: cheaper than eight rays
 /// at a time when the rays of `within` are few and spread over many blocks of eight. Each (ray, box)
-/// is decided by [`slab_avx`], as in [`meets_box_avx`], so with the same answer.
+/// is decided by [`slab_avx`], as in [`meets_boxes_avx`], so with the same answer.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx,avx2")]
 #[inline]
@@ -427,8 +423,7 @@ pub(super) unsafe fn meets_boxes_by_ray_avx(
 }
 
 /// [`meets_boxes`] in one call with AVX2: per block of eight lanes with a bit in `within`, its
-/// inverse directions loaded once and tested against each box of `alive` by [`slab_avx`], as
-/// [`meets_box_avx`] tests them.
+/// inverse directions loaded once and tested against each box of `alive` by [`slab_avx`].
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx,avx2")]
 #[inline]
@@ -472,44 +467,6 @@ unsafe fn meets_boxes_avx(
             out[c] |= (m & byte) << at;
         }
     }
-}
-
-/// [`meets_box`], eight lanes at a time (blocks of lanes with no bit in `within` are skipped).
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx,avx2")]
-#[inline]
-unsafe fn meets_box_avx(lo: Vec3, hi: Vec3, lanes: &BoxLanes, base: usize, within: u64) -> u64 {
-    use std::arch::x86_64::*;
-    let sp = |v: f32| _mm256_set1_ps(v);
-    let (lo, hi) = ([sp(lo.x), sp(lo.y), sp(lo.z)], [sp(hi.x), sp(hi.y), sp(hi.z)]);
-    let n = lanes.ix.len().min(lanes.iy.len()).min(lanes.iz.len());
-    // Each block of eight lanes with a bit in `within`: the first two, then the other six where
-    // `within` has a bit above 16 (loops of fixed length, so that they unroll).
-    let block = |block: usize| {
-        let byte = (within >> (block * 8)) & 0xff;
-        let j = base + block * LANES;
-        if byte != 0 && j + LANES <= n {
-            // SAFETY: j + LANES <= n <= every array's length; AVX2 is enabled here.
-            let m = unsafe {
-                let inv = [
-                    _mm256_loadu_ps(lanes.ix.as_ptr().add(j)),
-                    _mm256_loadu_ps(lanes.iy.as_ptr().add(j)),
-                    _mm256_loadu_ps(lanes.iz.as_ptr().add(j)),
-                ];
-                u64::from(slab_avx(lo, hi, inv))
-            };
-            (m & byte) << (block * 8)
-        } else {
-            0
-        }
-    };
-    let mut out = block(0) | block(1);
-    if within >> 16 != 0 {
-        for b in 2..8 {
-            out |= block(b);
-        }
-    }
-    out
 }
 
 /// The rays in lanes (see [`Fan`]).
