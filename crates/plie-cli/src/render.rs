@@ -314,6 +314,7 @@ fn print_answers(s: &QueryStats) {
             ("shaft", l.shaft),
             ("last blockers", l.last_blockers),
             ("scene BVH", l.scene),
+            ("(unsought)", l.unsought),
         ] {
             eprintln!("  {name:<14} {n:>12} {:>6.1}%", share(n));
         }

@@ -210,21 +210,24 @@ fn clustered_queries(scene: &Scene, built: &Built, clusters: usize, per: usize, 
 }
 
 /// Also the lights answered by the blockers of the light's last walk that found every ray
-/// occluded (`lie::light`): neighbouring points in shadow.
+/// occluded (`lie::light`): neighbouring points in shadow; and those whose footprints were not
+/// sought because their leaf's had decided nothing the last few times (`visibility::verdicts`).
 #[test]
 fn per_light_answers_from_shafts_equal_per_ray_and_brute_force() {
-    let (mut shaft, mut last) = (0, 0);
+    let (mut shaft, mut last, mut unsought) = (0, 0, 0);
     for name in ["cornell-cube-2", "huis-c", "dragon"] {
         let scene = plie::scene::builtin::load(name).unwrap();
         let built = Built::new(&scene, PlieParams::default());
         let stats = check(&scene, &built, &clustered_queries(&scene, &built, 24, 80, 26));
         shaft += stats.lights.shaft;
         last += stats.lights.last_blockers;
+        unsought += stats.lights.unsought;
     }
     // Some lights were answered from their pieces' shafts (each piece is asked up to 80 times),
     // and some by their last blockers.
     assert!(shaft > 0, "no light answered from a shaft");
     assert!(last > 0, "no light answered by its last blockers");
+    assert!(unsought > 0, "no light answered without its footprints");
 }
 
 fn cornell() -> &'static (Scene, Built) {

@@ -129,6 +129,10 @@ pub struct LightAnswers {
     /// piece of the point's triangle in its leaf to the light (pairs the footprints left to the
     /// scene BVH, from a piece asked before).
     pub shaft: u64,
+    /// Pairs whose footprints were not found, because those of their (leaf, light) had decided
+    /// nothing the last few times (`visibility::verdicts`); counted again among `shaft`,
+    /// `last_blockers` and `scene`.
+    pub unsought: u64,
 }
 
 impl std::ops::AddAssign for LightAnswers {
@@ -140,6 +144,7 @@ impl std::ops::AddAssign for LightAnswers {
         self.scene += o.scene;
         self.last_blockers += o.last_blockers;
         self.shaft += o.shaft;
+        self.unsought += o.unsought;
     }
 }
 

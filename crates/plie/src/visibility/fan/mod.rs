@@ -24,6 +24,7 @@
 
 use glam::Vec3;
 
+use super::verdicts::Verdicts;
 use super::{LightRays, QueryCtx};
 use crate::geometry::{RayTest, Triangle};
 use crate::scene::{Scene, TriId};
@@ -460,6 +461,8 @@ pub struct LightScratch {
     /// Per light (by index), the blockers of the last walk down the scene BVH that found every
     /// ray occluded ([`Fan::blockers`]; `u32::MAX` past the last, or for none).
     pub last_blockers: Vec<[u32; BLOCKERS]>,
+    /// Which (leaf, light) pairs' footprints decided nothing lately (`lie::light`).
+    pub verdicts: Verdicts,
 }
 
 impl LightScratch {

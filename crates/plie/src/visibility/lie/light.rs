@@ -12,7 +12,9 @@
 //! finding each sample's exit face, record and cell and testing its own list on every scene tried
 //! (docs/results.md, session 8). Before that walk, the blockers of the light's last walk that found
 //! every ray occluded are tested: in shadow that the footprints cannot decide, a neighbouring
-//! pixel's blockers often close every ray, and the walk is not needed.
+//! pixel's blockers often close every ray, and the walk is not needed. Where a leaf's footprints
+//! toward a light decided nothing the last few times, they are not sought
+//! ([`crate::visibility::verdicts`]), and the light goes straight to its shaft or the scene BVH.
 
 use super::super::fan::{Fan, LightScratch, Pyramid};
 use super::super::list_boxes::{Chunked, ListVisitor};
@@ -77,7 +79,21 @@ impl LieVisibility<'_> {
             // so only umbra can spare its lights the walk, and the footprints look for nothing else
             // (its lights come back as umbra or mixed, never lit or listed).
             let crowded = self.own[leaf.idx()].1 as usize > OWN_MAX;
-            match self.whole_light(leaf, &bounds, rays, &self.scene.lights[rays.light.idx()].vertices, crowded, sc) {
+            // Where this leaf's footprints toward the light decided nothing the last few times,
+            // they are not found ([`crate::visibility::verdicts`]): the light goes to the scene.
+            let whole = match sc.verdicts.ask(leaf, rays.light) {
+                Some(slot) => {
+                    let poly = &self.scene.lights[rays.light.idx()].vertices;
+                    let whole = self.whole_light(leaf, &bounds, rays, poly, crowded, sc);
+                    sc.verdicts.found(slot, whole != Whole::Mixed);
+                    whole
+                }
+                None => {
+                    ctx.stats.lights.unsought += 1;
+                    Whole::Mixed
+                }
+            };
+            match whole {
                 Whole::Umbra => {
                     out.fill(true);
                     ctx.stats.lights.whole_umbra += 1;
