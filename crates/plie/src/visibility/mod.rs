@@ -18,6 +18,7 @@ pub mod octree;
 pub(crate) mod pyramid;
 pub mod query;
 pub mod shadows;
+pub(crate) mod simd;
 pub(crate) mod verdicts;
 
 pub use answer::{Answer, Answers};

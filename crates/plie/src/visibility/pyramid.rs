@@ -8,6 +8,7 @@ use glam::{Vec3, Vec4};
 
 use crate::geometry::{Aabb, Triangle, TOLERANCE_REL};
 use crate::scene::{Light, LightId, Scene};
+use crate::visibility::simd::Avx2;
 
 /// The pyramid conv(`x` ∪ light polygon), as planes with inward unit normals through `x` (one per
 /// light edge) and the light's own plane, each grown outward by `margin`.
@@ -229,10 +230,12 @@ impl Pyramid {
     /// plane (the corner farthest along its normal still beyond it by the margin). Only the side
     /// planes are tested.
     #[inline(always)]
-    pub fn culls_rel8(&self, lo: &[[f32; 8]; 3], hi: &[[f32; 8]; 3]) -> u8 {
+    pub(crate) fn culls_rel8(&self, lo: &[[f32; 8]; 3], hi: &[[f32; 8]; 3], simd: Option<Avx2>) -> u8 {
+        #[cfg(not(target_arch = "x86_64"))]
+        let _ = simd;
         #[cfg(target_arch = "x86_64")]
-        if std::arch::is_x86_feature_detected!("avx2") {
-            // SAFETY: AVX2 is available (checked above).
+        if simd.is_some() {
+            // SAFETY: AVX2 is available (the proof).
             return unsafe { self.culls_rel8_avx(lo, hi) };
         }
         let m = -self.margin;
@@ -397,7 +400,7 @@ mod tests {
                     (lo[k][c], hi[k][c]) = (a.min(b), a.max(b));
                 }
             }
-            let bits = p.culls_rel8(&lo, &hi);
+            let bits = p.culls_rel8(&lo, &hi, Avx2::detect());
             for c in 0..8 {
                 let one = p.culls_rel(Vec3::new(lo[0][c], lo[1][c], lo[2][c]), Vec3::new(hi[0][c], hi[1][c], hi[2][c]));
                 assert_eq!(bits >> c & 1 == 1, one, "box {c}");

@@ -21,9 +21,10 @@
 //! every answer is [`super::segment_occluded`]'s, which is brute force's.
 //!
 //! Where the CPU has AVX2, the walk is compiled for it as a whole, so that the fan's lane kernels
-//! inline into it (measured: 2-8% fewer instructions per query, docs/results.md session 13), and a
-//! fan of at most 64 rays (one word of mask) has its own copy in which the loops over mask words
-//! collapse.
+//! inline into it (measured: 2-8% fewer instructions per query, docs/results.md session 13); it
+//! hands the proof of AVX2 ([`crate::visibility::simd::Avx2`]) down, so that no kernel checks the
+//! CPU again (3.4% fewer, session 27); and a fan of at most 64 rays (one word of mask) has its own
+//! copy in which the loops over mask words collapse.
 
 use glam::{Vec3, Vec3A};
 use obvhs::cwbvh::node::CwBvhNode;
@@ -32,6 +33,7 @@ use super::crowd::{Prims, Single};
 use super::cut::{Child, Cut, CUT_MAX};
 use super::{Bvh, LeafTris};
 use crate::visibility::fan::{nonzero_bytes, Fan, WalkStack};
+use crate::visibility::simd::Avx2;
 use crate::visibility::{LightRays, QueryCtx};
 
 impl Bvh {
@@ -51,14 +53,11 @@ impl Bvh {
         ctx: &mut QueryCtx,
     ) {
         #[cfg(target_arch = "x86_64")]
-        if std::arch::is_x86_feature_detected!("avx2")
-            && std::arch::is_x86_feature_detected!("popcnt")
-            && std::arch::is_x86_feature_detected!("bmi1")
-        {
-            // SAFETY: AVX2, POPCNT and BMI1 are available (checked above).
-            return unsafe { self.fan_occluded_avx(cut, rays, fan, walk, out, ctx) };
+        if let Some(simd) = Avx2::detect() {
+            // SAFETY: AVX2, POPCNT and BMI1 are available (the proof).
+            return unsafe { self.fan_occluded_avx(cut, rays, fan, walk, out, ctx, simd) };
         }
-        self.fan_occluded_in(cut, rays, fan, walk, out, ctx)
+        self.fan_occluded_in(cut, rays, fan, walk, out, ctx, None)
     }
 
     /// [`Bvh::fan_occluded`] compiled for AVX2 as a whole, so that the lane kernels (AVX2
@@ -76,8 +75,9 @@ impl Bvh {
         walk: &mut WalkStack,
         out: &mut [bool],
         ctx: &mut QueryCtx,
+        simd: Avx2,
     ) {
-        self.fan_occluded_in(cut, rays, fan, walk, out, ctx)
+        self.fan_occluded_in(cut, rays, fan, walk, out, ctx, Some(simd))
     }
 
     /// [`Bvh::fan_occluded`] for the BVH's kind of leaves.
@@ -91,14 +91,15 @@ impl Bvh {
         walk: &mut WalkStack,
         out: &mut [bool],
         ctx: &mut QueryCtx,
+        simd: Option<Avx2>,
     ) {
         // Up to 64 rays (one word of mask, the usual case) with the word count known to the
         // compiler.
         match (&self.groups, fan.words() == 1) {
-            (None, true) => self.fan_walk::<_, true>(cut, &Single, rays, fan, walk, out, ctx),
-            (None, false) => self.fan_walk::<_, false>(cut, &Single, rays, fan, walk, out, ctx),
-            (Some(g), true) => self.fan_walk::<_, true>(cut, g, rays, fan, walk, out, ctx),
-            (Some(g), false) => self.fan_walk::<_, false>(cut, g, rays, fan, walk, out, ctx),
+            (None, true) => self.fan_walk::<_, true>(cut, &Single, rays, fan, walk, out, ctx, simd),
+            (None, false) => self.fan_walk::<_, false>(cut, &Single, rays, fan, walk, out, ctx, simd),
+            (Some(g), true) => self.fan_walk::<_, true>(cut, g, rays, fan, walk, out, ctx, simd),
+            (Some(g), false) => self.fan_walk::<_, false>(cut, g, rays, fan, walk, out, ctx, simd),
         }
     }
 
@@ -113,6 +114,7 @@ impl Bvh {
         walk: &mut WalkStack,
         out: &mut [bool],
         ctx: &mut QueryCtx,
+        simd: Option<Avx2>,
     ) {
         let w = if ONE { 1 } else { fan.words() };
         if self.cw.nodes.is_empty() || fan.live() == 0 {
@@ -142,13 +144,15 @@ impl Bvh {
                         his[k][c] = (cut.hi[k][c] - apex[k]) * to_world;
                     }
                 }
-                let culled = fan.pyramid.culls_rel8(&los, &his);
+                let culled = fan.pyramid.culls_rel8(&los, &his, simd);
                 let filled = ((1u16 << cut.len) - 1) as u8;
                 node_mask.clear();
                 node_mask.extend_from_slice(fan.open());
-                let hit = fan.meets8(&los, &his, filled & !culled, &node_mask[..w], &mut child_masks[..8 * w], ctx);
+                let hit =
+                    fan.meets8(&los, &his, filled & !culled, &node_mask[..w], &mut child_masks[..8 * w], ctx, simd);
                 let at = (hit, &los, &his, |c: usize| cut.child[c]);
-                if self.take_children::<P, ONE>(prims, rays, fan, out, ctx, at, toward, nodes, masks, child_masks) {
+                if self.take_children::<P, ONE>(prims, rays, fan, out, ctx, at, toward, nodes, masks, child_masks, simd)
+                {
                     return;
                 }
             }
@@ -178,7 +182,7 @@ impl Bvh {
                 let word = node_mask.iter().zip(fan.open()).position(|(m, o)| m & o != 0).unwrap_or(0);
                 let k = word * 64 + (node_mask[word] & fan.open()[word]).trailing_zeros() as usize;
                 let at = (ni, k, apex, to_world);
-                if self.ray_walk::<P, ONE>(prims, rays, fan, out, ctx, at, ray_nodes, ray_mask) {
+                if self.ray_walk::<P, ONE>(prims, rays, fan, out, ctx, at, ray_nodes, ray_mask, simd) {
                     return;
                 }
                 continue;
@@ -186,11 +190,11 @@ impl Bvh {
             let node = &self.cw.nodes[ni as usize];
             let (los, his) = child_boxes(node, apex, to_world);
             // For a few rays, their own slab tests cull as well as the pyramid would.
-            let culled = if count <= CULL_ABOVE { 0 } else { fan.pyramid.culls_rel8(&los, &his) };
+            let culled = if count <= CULL_ABOVE { 0 } else { fan.pyramid.culls_rel8(&los, &his, simd) };
             let filled = nonzero_bytes(u64::from_le_bytes(node.child_meta));
-            let hit = fan.meets8(&los, &his, filled & !culled, &node_mask[..w], &mut child_masks[..8 * w], ctx);
+            let hit = fan.meets8(&los, &his, filled & !culled, &node_mask[..w], &mut child_masks[..8 * w], ctx, simd);
             let at = (hit, &los, &his, |c: usize| Child::of(node, c));
-            if self.take_children::<P, ONE>(prims, rays, fan, out, ctx, at, toward, nodes, masks, child_masks) {
+            if self.take_children::<P, ONE>(prims, rays, fan, out, ctx, at, toward, nodes, masks, child_masks, simd) {
                 return;
             }
         }
@@ -212,6 +216,7 @@ impl Bvh {
         (root, k, apex, to_world): (u32, usize, Vec3A, f32),
         stack: &mut Vec<u32>,
         mask: &mut Vec<u64>,
+        simd: Option<Avx2>,
     ) -> bool {
         let w = if ONE { 1 } else { fan.words() };
         let (word, bit) = (k / 64, 1u64 << (k % 64));
@@ -224,14 +229,14 @@ impl Bvh {
             let node = &self.cw.nodes[ni as usize];
             let (los, his) = child_boxes(node, apex, to_world);
             let filled = nonzero_bytes(u64::from_le_bytes(node.child_meta));
-            let mut hit = fan.ray_meets8(&los, &his, filled, k, ctx);
+            let mut hit = fan.ray_meets8(&los, &his, filled, k, ctx, simd);
             while hit != 0 {
                 let c = hit.trailing_zeros() as usize;
                 hit &= hit - 1;
                 match Child::of(node, c) {
                     Child::None => {}
                     Child::Leaf(start, len) => {
-                        self.test_leaf(prims, rays, fan, (start, len), &mask[..w], out, ctx);
+                        self.test_leaf(prims, rays, fan, (start, len), &mask[..w], out, ctx, simd);
                         if fan.open()[word] & bit == 0 {
                             return fan.live() == 0;
                         }
@@ -256,12 +261,13 @@ impl Bvh {
         mask: &[u64],
         out: &mut [bool],
         ctx: &mut QueryCtx,
+        simd: Option<Avx2>,
     ) {
         let LeafTris { tris, ids, lights } = &self.leaf_tris;
         let span = prims.span(start, len);
         for ((tri, &t), &light) in tris[span.clone()].iter().zip(&ids[span.clone()]).zip(&lights[span]) {
             if !rays.own_with(t, light) {
-                fan.test_within(tri, t, rays, mask, out, ctx);
+                fan.test_within(tri, t, rays, mask, out, ctx, simd);
             }
         }
     }
@@ -283,6 +289,7 @@ impl Bvh {
         nodes: &mut Vec<u32>,
         masks: &mut Vec<u64>,
         child_masks: &[u64],
+        simd: Option<Avx2>,
     ) -> bool {
         let w = if ONE { 1 } else { fan.words() };
         let mut pending = [(0f32, 0u32, 0usize); 8];
@@ -295,7 +302,7 @@ impl Bvh {
             match child_of(child) {
                 Child::None => {}
                 Child::Leaf(start, len) => {
-                    self.test_leaf(prims, rays, fan, (start, len), mask, out, ctx);
+                    self.test_leaf(prims, rays, fan, (start, len), mask, out, ctx, simd);
                     if fan.live() == 0 {
                         return true;
                     }

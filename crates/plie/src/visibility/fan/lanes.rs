@@ -10,6 +10,7 @@ use super::LANES;
 #[cfg(target_arch = "x86_64")]
 use crate::geometry::Triangle;
 use crate::geometry::SEGMENT_EPS;
+use crate::visibility::simd::Avx2;
 
 /// The inverse of a direction's component for the slab test, with a non-finite one (of a zero or
 /// tiny component) replaced by `±f32::MAX`. A product with it is then never NaN, and the slab it gives
@@ -292,6 +293,7 @@ pub(super) fn meets_box(lo: Vec3, hi: Vec3, lanes: &BoxLanes, base: usize, withi
 /// (`lo[axis][c]`, `hi[axis][c]`): `out[c]` becomes the bits of `within` whose segments meet box `c`
 /// (0 for the others).
 #[inline(always)]
+#[allow(clippy::too_many_arguments)]
 pub(super) fn meets_boxes(
     lo: &[[f32; 8]; 3],
     hi: &[[f32; 8]; 3],
@@ -300,14 +302,17 @@ pub(super) fn meets_boxes(
     base: usize,
     within: u64,
     out: &mut [u64; 8],
+    simd: Option<Avx2>,
 ) {
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = simd;
     #[cfg(target_arch = "x86_64")]
-    if std::arch::is_x86_feature_detected!("avx2") {
+    if simd.is_some() {
         // Eight rays at a time costs a test per box and block of eight holding a ray of `within`;
         // one ray at a time, a test per ray (measured by callgrind on five scenes at 64 rays,
         // docs/results.md session 9: weighing the two from 1:2 to 3:1 changed little).
         let blocks = nonzero_bytes(within).count_ones();
-        // SAFETY: AVX2 is available (checked above); the lane arrays are padded to whole blocks.
+        // SAFETY: AVX2 is available (the proof); the lane arrays are padded to whole blocks.
         unsafe {
             if within.count_ones() < alive.count_ones() * blocks {
                 meets_boxes_by_ray_avx(lo, hi, alive, lanes, base, within, out);
@@ -344,10 +349,19 @@ fn each_box(lo: &[[f32; 8]; 3], hi: &[[f32; 8]; 3], alive: u8, out: &mut [u64; 8
 /// (`lo[axis][c]`, `hi[axis][c]`), those that the segment of ray `j` meets, as bits: [`meets_box`]'s
 /// test of one ray against eight boxes.
 #[inline(always)]
-pub(super) fn ray_meets_boxes(lo: &[[f32; 8]; 3], hi: &[[f32; 8]; 3], alive: u8, lanes: &BoxLanes, j: usize) -> u8 {
+pub(super) fn ray_meets_boxes(
+    lo: &[[f32; 8]; 3],
+    hi: &[[f32; 8]; 3],
+    alive: u8,
+    lanes: &BoxLanes,
+    j: usize,
+    simd: Option<Avx2>,
+) -> u8 {
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = simd;
     #[cfg(target_arch = "x86_64")]
-    if std::arch::is_x86_feature_detected!("avx2") {
-        // SAFETY: AVX2 is available (checked above).
+    if simd.is_some() {
+        // SAFETY: AVX2 is available (the proof).
         return unsafe { ray_meets_boxes_avx(lo, hi, alive, lanes, j) };
     }
     let corner = |v: &[[f32; 8]; 3], c: usize| Vec3::new(v[0][c], v[1][c], v[2][c]);
@@ -487,10 +501,12 @@ const T_MARGIN: f32 = 1e-5;
 /// `s` (see [`Fan::test`]), or its hit parameter cannot fall in the segment's range (`span`: per
 /// axis, the least and greatest vertex coordinate, taken along the lane's `kz`).
 #[inline]
-pub(super) fn misses(s: &[Vec3; 3], span: &[(f32, f32); 3], lanes: &Lanes, maybe: &mut [u64]) {
+pub(super) fn misses(s: &[Vec3; 3], span: &[(f32, f32); 3], lanes: &Lanes, maybe: &mut [u64], simd: Option<Avx2>) {
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = simd;
     #[cfg(target_arch = "x86_64")]
-    if std::arch::is_x86_feature_detected!("avx2") {
-        // SAFETY: AVX2 is available (checked above); the lane arrays are padded to whole blocks.
+    if simd.is_some() {
+        // SAFETY: AVX2 is available (the proof); the lane arrays are padded to whole blocks.
         unsafe { misses_avx(s, span, lanes, maybe) };
         return;
     }
@@ -815,7 +831,11 @@ mod tests {
                 // One ray alone against the eight boxes (the walk's `ray_walk`) answers alike.
                 for j in (0..64).filter(|j| within >> j & 1 != 0) {
                     let want = (0..8).fold(0u8, |m, c| m | u8::from(by_block[c] >> j & 1 != 0) << c);
-                    assert_eq!(ray_meets_boxes(&lo, &hi, alive, &lanes, j), want, "round {round}, ray {j}");
+                    assert_eq!(
+                        ray_meets_boxes(&lo, &hi, alive, &lanes, j, Avx2::detect()),
+                        want,
+                        "round {round}, ray {j}"
+                    );
                 }
                 met += by_ray.iter().map(|m| m.count_ones()).sum::<u32>();
             }

@@ -24,6 +24,7 @@
 
 use glam::Vec3;
 
+use super::simd::Avx2;
 use super::verdicts::Verdicts;
 use super::{LightRays, QueryCtx};
 use crate::geometry::{RayTest, Triangle};
@@ -86,23 +87,23 @@ impl Fan {
     /// Starts the fan of `rays` (directions computed exactly as [`super::ShadowRay::new`] does).
     pub fn set(&mut self, rays: &LightRays) {
         #[cfg(target_arch = "x86_64")]
-        if std::arch::is_x86_feature_detected!("avx2") {
-            // SAFETY: AVX2 is available (checked above).
-            return unsafe { self.set_avx(rays) };
+        if let Some(simd) = Avx2::detect() {
+            // SAFETY: AVX2 is available (the proof).
+            return unsafe { self.set_avx(rays, simd) };
         }
-        self.set_in(rays)
+        self.set_in(rays, None)
     }
 
     /// [`Fan::set`] compiled for AVX2 as a whole, so that its lane kernels inline into it.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx,avx2")]
-    unsafe fn set_avx(&mut self, rays: &LightRays) {
-        self.set_in(rays)
+    unsafe fn set_avx(&mut self, rays: &LightRays, simd: Avx2) {
+        self.set_in(rays, Some(simd))
     }
 
     /// The body of [`Fan::set`].
     #[inline(always)]
-    fn set_in(&mut self, rays: &LightRays) {
+    fn set_in(&mut self, rays: &LightRays, simd: Option<Avx2>) {
         let x = rays.origin;
         let n = rays.targets.len();
         self.origin = x;
@@ -124,9 +125,11 @@ impl Fan {
         // Blocks of eight rays in one pass where the CPU has AVX2 (the last one padded: the
         // arrays hold whole blocks); without it, ray by ray, as those lanes compute them.
         let mut done = 0;
+        #[cfg(not(target_arch = "x86_64"))]
+        let _ = simd;
         #[cfg(target_arch = "x86_64")]
-        if std::arch::is_x86_feature_detected!("avx2") {
-            // SAFETY: AVX2 is available (checked above).
+        if simd.is_some() {
+            // SAFETY: AVX2 is available (the proof).
             done = unsafe {
                 fan_lanes_avx(rays.targets, x, &mut self.all, &mut self.all_kz, &mut self.shear_s, &mut self.shear_k)
             };
@@ -217,16 +220,28 @@ impl Fan {
     /// `out[k]` set and is closed. Blocks of eight rays with two or more to test take the
     /// lane-wide copy of the test ([`lanes::exact_avx`]), which answers as it does.
     #[inline(always)]
-    fn exact(&mut self, tri: &Triangle, w: usize, bits: u64, rays: &LightRays, out: &mut [bool], ctx: &mut QueryCtx) {
+    #[allow(clippy::too_many_arguments)]
+    fn exact(
+        &mut self,
+        tri: &Triangle,
+        w: usize,
+        bits: u64,
+        rays: &LightRays,
+        out: &mut [bool],
+        ctx: &mut QueryCtx,
+        simd: Option<Avx2>,
+    ) {
         if bits == 0 {
             return;
         }
         ctx.stats.triangle_tests += u64::from(bits.count_ones());
         let mut one_by_one = bits;
         let mut hits = 0u64;
+        #[cfg(not(target_arch = "x86_64"))]
+        let _ = simd;
         #[cfg(target_arch = "x86_64")]
-        if std::arch::is_x86_feature_detected!("avx2") {
-            // SAFETY: AVX2 is available (checked above).
+        if simd.is_some() {
+            // SAFETY: AVX2 is available (the proof).
             let v = unsafe { vertices_rel(tri, self.origin) };
             let [sx, sy] = &self.shear_s;
             let [kx, ky] = &self.shear_k;
@@ -238,7 +253,7 @@ impl Fan {
                 let at = rest.trailing_zeros() as usize / LANES * LANES;
                 let byte = rest >> at & 0xff;
                 rest &= !(0xff << at);
-                // SAFETY: AVX2 is available (checked above); the shear lanes are padded to whole
+                // SAFETY: AVX2 is available (the proof); the shear lanes are padded to whole
                 // blocks.
                 let (hit, scalar) = unsafe { exact_avx(v, &shear, w * 64 + at) };
                 hits |= (u64::from(hit) & byte) << at;
@@ -289,6 +304,7 @@ impl Fan {
     /// the box). Returns the boxes some ray meets, as bits. Counts a
     /// box test per ray and box tested.
     #[inline(always)]
+    #[allow(clippy::too_many_arguments)]
     pub fn meets8(
         &self,
         lo: &[[f32; 8]; 3],
@@ -297,6 +313,7 @@ impl Fan {
         within: &[u64],
         to: &mut [u64],
         ctx: &mut QueryCtx,
+        simd: Option<Avx2>,
     ) -> u8 {
         let [.., ix, iy, iz] = &self.all;
         let lanes = BoxLanes { ix, iy, iz };
@@ -311,7 +328,7 @@ impl Fan {
                 out = [0; 8];
             } else {
                 ctx.stats.box_tests += u64::from(f.count_ones() * alive.count_ones());
-                meets_boxes(lo, hi, alive, &lanes, i * 64, f, &mut out);
+                meets_boxes(lo, hi, alive, &lanes, i * 64, f, &mut out, simd);
             }
             if w == 1 {
                 to[..8].copy_from_slice(&out);
@@ -331,16 +348,25 @@ impl Fan {
     /// that the segment of ray `k` meets, as bits: [`Fan::meets8`]'s test for one ray. Counts a box
     /// test per box tested.
     #[inline(always)]
-    pub fn ray_meets8(&self, lo: &[[f32; 8]; 3], hi: &[[f32; 8]; 3], alive: u8, k: usize, ctx: &mut QueryCtx) -> u8 {
+    pub fn ray_meets8(
+        &self,
+        lo: &[[f32; 8]; 3],
+        hi: &[[f32; 8]; 3],
+        alive: u8,
+        k: usize,
+        ctx: &mut QueryCtx,
+        simd: Option<Avx2>,
+    ) -> u8 {
         let [.., ix, iy, iz] = &self.all;
         ctx.stats.box_tests += u64::from(alive.count_ones());
-        ray_meets_boxes(lo, hi, alive, &BoxLanes { ix, iy, iz }, k)
+        ray_meets_boxes(lo, hi, alive, &BoxLanes { ix, iy, iz }, k, simd)
     }
 
     /// [`Fan::test`] of triangle `t`, given as `tri` (the scene's or a copy of it), for the open
     /// lanes of `within` only: up to [`DIRECT_MAX`] lanes go straight to the watertight test, more
     /// first through the eight-lane edge test.
     #[inline]
+    #[allow(clippy::too_many_arguments)]
     pub(crate) fn test_within(
         &mut self,
         tri: &Triangle,
@@ -349,8 +375,9 @@ impl Fan {
         within: &[u64],
         out: &mut [bool],
         ctx: &mut QueryCtx,
+        simd: Option<Avx2>,
     ) {
-        self.test_masked(tri, t, rays, Some(within), out, ctx);
+        self.test_masked(tri, t, rays, Some(within), out, ctx, simd);
     }
 
     /// Rays not yet found occluded.
@@ -364,13 +391,22 @@ impl Fan {
     /// test per open ray through the edge test, and a triangle test per ray given the watertight
     /// test. The caller has excluded the rays' own triangles (the origin's and the light's).
     #[inline]
-    pub fn test(&mut self, scene: &Scene, rays: &LightRays, t: TriId, out: &mut [bool], ctx: &mut QueryCtx) {
-        self.test_masked(&scene.triangles[t.idx()], t, rays, None, out, ctx);
+    pub fn test(
+        &mut self,
+        scene: &Scene,
+        rays: &LightRays,
+        t: TriId,
+        out: &mut [bool],
+        ctx: &mut QueryCtx,
+        simd: Option<Avx2>,
+    ) {
+        self.test_masked(&scene.triangles[t.idx()], t, rays, None, out, ctx, simd);
     }
 
     /// [`Fan::test`], for the open lanes of `within` only when given: up to [`DIRECT_MAX`] of them
     /// go straight to the watertight test, more first through the edge test.
     #[inline(always)]
+    #[allow(clippy::too_many_arguments)]
     fn test_masked(
         &mut self,
         tri: &Triangle,
@@ -379,6 +415,7 @@ impl Fan {
         within: Option<&[u64]>,
         out: &mut [bool],
         ctx: &mut QueryCtx,
+        simd: Option<Avx2>,
     ) {
         let mask = |w: usize| within.map_or(u64::MAX, |m| m[w]);
         // The words of the mask (from `within` where given, so a caller that knows it lets the
@@ -393,7 +430,7 @@ impl Fan {
         if count <= DIRECT_MAX {
             for w in 0..words {
                 let bits = self.open[w] & mask(w);
-                self.exact(tri, w, bits, rays, out, ctx);
+                self.exact(tri, w, bits, rays, out, ctx, simd);
             }
         } else {
             let x = self.origin;
@@ -418,13 +455,13 @@ impl Fan {
             if s.iter().all(|v| v.is_finite()) {
                 let [x, y, z, len, sz, ..] = &self.all;
                 let lanes = Lanes { x, y, z, len, sz, kz: &self.all_kz };
-                misses(&s, &span, &lanes, &mut self.maybe);
+                misses(&s, &span, &lanes, &mut self.maybe, simd);
             } else {
                 self.maybe.fill(u64::MAX);
             }
             for w in 0..words {
                 let bits = self.maybe[w] & self.open[w] & mask(w);
-                self.exact(tri, w, bits, rays, out, ctx);
+                self.exact(tri, w, bits, rays, out, ctx, simd);
             }
         }
         if self.live < live {
@@ -473,6 +510,38 @@ impl LightScratch {
     /// changes no answer, only which triangle closes a ray: in shadow, a neighbouring pixel's
     /// blockers often close every ray, and the walk is not needed.
     pub fn test_last_blockers(&mut self, scene: &Scene, rays: &LightRays, out: &mut [bool], ctx: &mut QueryCtx) {
+        #[cfg(target_arch = "x86_64")]
+        if let Some(simd) = Avx2::detect() {
+            // SAFETY: AVX2, POPCNT and BMI1 are available (the proof).
+            return unsafe { self.test_last_blockers_avx(scene, rays, out, ctx, simd) };
+        }
+        self.test_last_blockers_in(scene, rays, out, ctx, None)
+    }
+
+    /// [`LightScratch::test_last_blockers`] compiled for AVX2, so that the fan's kernels inline.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx,avx2,popcnt,bmi1")]
+    unsafe fn test_last_blockers_avx(
+        &mut self,
+        scene: &Scene,
+        rays: &LightRays,
+        out: &mut [bool],
+        ctx: &mut QueryCtx,
+        simd: Avx2,
+    ) {
+        self.test_last_blockers_in(scene, rays, out, ctx, Some(simd))
+    }
+
+    /// The body of [`LightScratch::test_last_blockers`].
+    #[inline(always)]
+    fn test_last_blockers_in(
+        &mut self,
+        scene: &Scene,
+        rays: &LightRays,
+        out: &mut [bool],
+        ctx: &mut QueryCtx,
+        simd: Option<Avx2>,
+    ) {
         let li = rays.light.idx();
         if self.last_blockers.len() <= li {
             self.last_blockers.resize(scene.lights.len().max(li + 1), [u32::MAX; BLOCKERS]);
@@ -485,7 +554,7 @@ impl LightScratch {
                 continue;
             }
             if !self.fan.pyramid.culls(tri) {
-                self.fan.test(scene, rays, t, out, ctx);
+                self.fan.test(scene, rays, t, out, ctx, simd);
                 if self.fan.live() == 0 {
                     return;
                 }

@@ -25,6 +25,7 @@ use super::LieVisibility;
 use crate::geometry::Aabb;
 use crate::octree::LeafId;
 use crate::scene::TriId;
+use crate::visibility::simd::Avx2;
 
 impl LieVisibility<'_> {
     /// [`Whole::Lists`]: every sample against every gathered list, then the leaf's own triangles,
@@ -166,24 +167,29 @@ impl LieVisibility<'_> {
     /// [`Self::fan_tris`] over a shaft's list, compiled for AVX2 where the CPU has it.
     fn fan_shaft(&self, rays: &LightRays, tris: &[TriId], fan: &mut Fan, out: &mut [bool], ctx: &mut QueryCtx) {
         #[cfg(target_arch = "x86_64")]
-        if std::arch::is_x86_feature_detected!("avx2")
-            && std::arch::is_x86_feature_detected!("popcnt")
-            && std::arch::is_x86_feature_detected!("bmi1")
-        {
-            // SAFETY: AVX2, POPCNT and BMI1 are available (checked above).
-            return unsafe { self.fan_shaft_avx(rays, tris, fan, out, ctx) };
+        if let Some(simd) = Avx2::detect() {
+            // SAFETY: AVX2, POPCNT and BMI1 are available (the proof).
+            return unsafe { self.fan_shaft_avx(rays, tris, fan, out, ctx, simd) };
         }
-        self.fan_shaft_in(rays, tris, fan, out, ctx)
+        self.fan_shaft_in(rays, tris, fan, out, ctx, None)
     }
 
     /// The body of [`Self::fan_shaft`]: each triangle against the open rays.
     #[inline(always)]
-    fn fan_shaft_in(&self, rays: &LightRays, tris: &[TriId], fan: &mut Fan, out: &mut [bool], ctx: &mut QueryCtx) {
+    fn fan_shaft_in(
+        &self,
+        rays: &LightRays,
+        tris: &[TriId],
+        fan: &mut Fan,
+        out: &mut [bool],
+        ctx: &mut QueryCtx,
+        simd: Option<Avx2>,
+    ) {
         for &t in tris {
             if fan.live() == 0 {
                 return;
             }
-            fan.test(self.scene, rays, t, out, ctx);
+            fan.test(self.scene, rays, t, out, ctx, simd);
         }
     }
 
@@ -197,8 +203,9 @@ impl LieVisibility<'_> {
         fan: &mut Fan,
         out: &mut [bool],
         ctx: &mut QueryCtx,
+        simd: Avx2,
     ) {
-        self.fan_shaft_in(rays, tris, fan, out, ctx)
+        self.fan_shaft_in(rays, tris, fan, out, ctx, Some(simd))
     }
 
     /// The blocker list of `key` with its chunk boxes.
@@ -267,6 +274,7 @@ impl LieVisibility<'_> {
     /// Tests the triangles `tris` that the pyramid does not cull against the fan's open rays,
     /// marking those hit in `out`; with `once`, only those not met before in the query.
     #[inline(always)]
+    #[allow(clippy::too_many_arguments)]
     fn fan_tris(
         &self,
         rays: &LightRays,
@@ -275,6 +283,7 @@ impl LieVisibility<'_> {
         fan: &mut Fan,
         out: &mut [bool],
         ctx: &mut QueryCtx,
+        simd: Option<Avx2>,
     ) {
         for &t in tris {
             if fan.live() == 0 {
@@ -287,7 +296,7 @@ impl LieVisibility<'_> {
             if fan.pyramid.culls(&self.scene.triangles[t.idx()]) {
                 continue;
             }
-            fan.test(self.scene, rays, t, out, ctx);
+            fan.test(self.scene, rays, t, out, ctx, simd);
         }
     }
 
@@ -304,19 +313,17 @@ impl LieVisibility<'_> {
         ctx: &mut QueryCtx,
     ) {
         #[cfg(target_arch = "x86_64")]
-        if std::arch::is_x86_feature_detected!("avx2")
-            && std::arch::is_x86_feature_detected!("popcnt")
-            && std::arch::is_x86_feature_detected!("bmi1")
-        {
-            // SAFETY: AVX2, POPCNT and BMI1 are available (checked above).
-            return unsafe { self.fan_list_avx(rays, list, once, fan, out, ctx) };
+        if let Some(simd) = Avx2::detect() {
+            // SAFETY: AVX2, POPCNT and BMI1 are available (the proof).
+            return unsafe { self.fan_list_avx(rays, list, once, fan, out, ctx, simd) };
         }
-        self.fan_list_in(rays, list, once, fan, out, ctx)
+        self.fan_list_in(rays, list, once, fan, out, ctx, None)
     }
 
     /// [`Self::fan_list`] compiled for AVX2: the same operations, so the same answers.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx,avx2,popcnt,bmi1")]
+    #[allow(clippy::too_many_arguments)]
     unsafe fn fan_list_avx(
         &self,
         rays: &LightRays,
@@ -325,12 +332,14 @@ impl LieVisibility<'_> {
         fan: &mut Fan,
         out: &mut [bool],
         ctx: &mut QueryCtx,
+        simd: Avx2,
     ) {
-        self.fan_list_in(rays, list, once, fan, out, ctx)
+        self.fan_list_in(rays, list, once, fan, out, ctx, Some(simd))
     }
 
     /// The body of [`Self::fan_list`].
     #[inline(always)]
+    #[allow(clippy::too_many_arguments)]
     fn fan_list_in(
         &self,
         rays: &LightRays,
@@ -339,6 +348,7 @@ impl LieVisibility<'_> {
         fan: &mut Fan,
         out: &mut [bool],
         ctx: &mut QueryCtx,
+        simd: Option<Avx2>,
     ) {
         /// The pyramid down the hierarchy, then the fan at its chunks.
         struct Tris<'v, 'a, 'c> {
@@ -348,6 +358,7 @@ impl LieVisibility<'_> {
             fan: &'c mut Fan,
             out: &'c mut [bool],
             ctx: &'c mut QueryCtx,
+            simd: Option<Avx2>,
         }
         impl ListVisitor for Tris<'_, '_, '_> {
             #[inline(always)]
@@ -357,12 +368,12 @@ impl LieVisibility<'_> {
             }
             #[inline(always)]
             fn chunk(&mut self, tris: &[TriId], _: usize) -> bool {
-                self.vis.fan_tris(self.rays, tris, self.once, self.fan, self.out, self.ctx);
+                self.vis.fan_tris(self.rays, tris, self.once, self.fan, self.out, self.ctx, self.simd);
                 self.fan.live() == 0
             }
         }
         if fan.live() > 0 {
-            list.walk(&mut Tris { vis: self, rays, once, fan, out, ctx });
+            list.walk(&mut Tris { vis: self, rays, once, fan, out, ctx, simd });
         }
     }
 }
