@@ -14,10 +14,12 @@ use crate::visibility::simd::Avx2;
 /// light edge) and the light's own plane, each grown outward by `margin`.
 #[derive(Clone, Debug, Default)]
 pub struct Pyramid {
-    /// Inward unit normals of the side planes (through the apex).
+    /// Inward unit normals of the side planes (through the apex), for more than four sides.
     sides: Vec<Vec3>,
-    /// The same normals' `x`, `y` and `z` in four lanes, for at most four sides (a triangle's third
-    /// side repeated); `None` for more sides.
+    /// For at most four sides: their normals (`few[..n]`), and the same normals' `x`, `y` and `z`
+    /// in four lanes (a triangle's third side repeated); `None` for more sides.
+    few: [Vec3; 4],
+    n: usize,
     lanes: Option<[Vec4; 3]>,
     /// Unit normal of the light plane pointing toward the apex, and the plane's offset.
     cap: (Vec3, f32),
@@ -76,6 +78,17 @@ fn corner_lanes(v: &[Vec3]) -> ([Vec4; 3], [Vec4; 3]) {
 }
 
 impl Pyramid {
+    /// Inward unit normals of the side planes (through the apex); none where the pyramid is not
+    /// defined.
+    #[inline(always)]
+    fn sides(&self) -> &[Vec3] {
+        if self.lanes.is_some() {
+            &self.few[..self.n]
+        } else {
+            &self.sides
+        }
+    }
+
     /// [`Pyramid::set`] for a light of at most four corners from its precomputed `basis`: the same
     /// operations on the same values, so the same pyramid, bit for bit.
     pub fn set_from(&mut self, x: Vec3, basis: &PyramidBasis, margin: f32) -> bool {
@@ -89,6 +102,7 @@ impl Pyramid {
     fn start(&mut self, x: Vec3, cap: (Vec3, f32), v0: Vec3, margin: f32) -> bool {
         self.sides.clear();
         self.lanes = None;
+        self.n = 0;
         self.apex = x;
         self.margin = margin;
         self.cap = cap;
@@ -170,8 +184,13 @@ impl Pyramid {
         let (sx, sy, sz) = (sx / len, sy / len, sz / len);
         let flip = (sx * toward_centre.x + sy * toward_centre.y + sz * toward_centre.z).cmplt(Vec4::ZERO);
         let (sx, sy, sz) = (Vec4::select(flip, -sx, sx), Vec4::select(flip, -sy, sy), Vec4::select(flip, -sz, sz));
-        let sides = [0, 1, 2, 3].map(|i| Vec3::new(sx[i], sy[i], sz[i]));
-        self.sides.extend_from_slice(&sides[..n]);
+        self.few = [
+            Vec3::new(sx.x, sy.x, sz.x),
+            Vec3::new(sx.y, sy.y, sz.y),
+            Vec3::new(sx.z, sy.z, sz.z),
+            Vec3::new(sx.w, sy.w, sz.w),
+        ];
+        self.n = n;
         self.lanes = Some([sx, sy, sz]);
         true
     }
@@ -196,13 +215,13 @@ impl Pyramid {
                 return true;
             }
         } else {
-            for s in &self.sides {
+            for s in self.sides() {
                 if s.dot(a) < -m && s.dot(b) < -m && s.dot(c) < -m {
                     return true;
                 }
             }
         }
-        if self.sides.is_empty() {
+        if self.sides().is_empty() {
             return false;
         }
         let (n, off) = self.cap;
@@ -222,7 +241,7 @@ impl Pyramid {
             let d = far(sx, lo.x, hi.x) + far(sy, lo.y, hi.y) + far(sz, lo.z, hi.z);
             return d.cmplt(Vec4::splat(-m)).any();
         }
-        self.sides.iter().any(|s| s.dot(Vec3::select(s.cmpge(Vec3::ZERO), hi, lo)) < -m)
+        self.sides().iter().any(|s| s.dot(Vec3::select(s.cmpge(Vec3::ZERO), hi, lo)) < -m)
     }
 
     /// Which of eight boxes, given relative to the apex as lanes (`lo[axis][c]`, `hi[axis][c]` for
@@ -240,7 +259,7 @@ impl Pyramid {
         }
         let m = -self.margin;
         let mut culled = [0u32; 8];
-        for s in self.sides.iter().copied() {
+        for s in self.sides().iter().copied() {
             let far = |k: usize| if s[k] >= 0.0 { hi[k] } else { lo[k] };
             let (fx, fy, fz) = (far(0), far(1), far(2));
             for c in 0..8 {
@@ -259,7 +278,7 @@ impl Pyramid {
         use std::arch::x86_64::*;
         let m = _mm256_set1_ps(-self.margin);
         let mut culled = _mm256_setzero_ps();
-        for s in self.sides.iter().copied() {
+        for s in self.sides().iter().copied() {
             let far = |k: usize| {
                 let v = if s[k] >= 0.0 { &hi[k] } else { &lo[k] };
                 // SAFETY: eight floats.
@@ -278,14 +297,14 @@ impl Pyramid {
     /// True if no segment of the pyramid can meet anything in the box `b`.
     #[inline]
     pub fn culls_box(&self, b: &Aabb) -> bool {
-        if self.sides.is_empty() {
+        if self.sides().is_empty() {
             return false;
         }
         let x = self.apex;
         let m = self.margin;
         // The box corner farthest along the normal.
         let far = |s: Vec3| Vec3::select(s.cmpge(Vec3::ZERO), b.max, b.min);
-        for s in &self.sides {
+        for s in self.sides() {
             if s.dot(far(*s) - x) < -m {
                 return true;
             }
@@ -328,6 +347,7 @@ mod tests {
             let mut p = Pyramid::default();
             assert!(p.set(Vec3::new(0.3, 0.0, 0.4), &light, 1e-4));
             let mut loop_only = p.clone();
+            loop_only.sides = p.sides().to_vec();
             loop_only.lanes = None;
             for _ in 0..20_000 {
                 let mut v =
@@ -360,7 +380,7 @@ mod tests {
                 let ok = a.set(x, &light, 1e-4);
                 assert_eq!(b.set_from(x, &basis, 1e-4), ok, "{x}");
                 let bits = |p: &Pyramid| {
-                    let sides: Vec<[u32; 3]> = p.sides.iter().map(|s| s.to_array().map(f32::to_bits)).collect();
+                    let sides: Vec<[u32; 3]> = p.sides().iter().map(|s| s.to_array().map(f32::to_bits)).collect();
                     let lanes = p.lanes.map(|l| l.map(|v| v.to_array().map(f32::to_bits)));
                     (sides, lanes, p.cap.0.to_array().map(f32::to_bits), p.cap.1.to_bits(), p.apex, p.margin)
                 };
@@ -427,12 +447,12 @@ mod tests {
             let (mut a, mut b) = (Pyramid::default(), Pyramid::default());
             let (ra, rb) = (a.set_sides(x, &v, toward), b.set_sides_lanes(x, &v, toward));
             assert_eq!(ra, rb, "apex {x}, light {v:?}");
-            assert_eq!(bits(&a.sides), bits(&b.sides), "apex {x}, light {v:?}");
+            assert_eq!(bits(a.sides()), bits(b.sides()), "apex {x}, light {v:?}");
             // The lanes hold the loop's sides, a triangle's last one twice.
             if ra {
                 let [sx, sy, sz] = b.lanes.expect("lanes for at most four sides");
                 let lane_sides: Vec<Vec3> = (0..4).map(|i| Vec3::new(sx[i], sy[i], sz[i])).collect();
-                let padded: Vec<Vec3> = (0..4).map(|i| a.sides[i.min(n - 1)]).collect();
+                let padded: Vec<Vec3> = (0..4).map(|i| a.sides()[i.min(n - 1)]).collect();
                 assert_eq!(bits(&lane_sides), bits(&padded), "apex {x}, light {v:?}");
             }
             refused += usize::from(!ra);
