@@ -5,6 +5,7 @@
 
 /// Held only where the CPU has AVX2, POPCNT and BMI1 ([`Avx2::detect`]).
 #[derive(Clone, Copy, Debug)]
+#[cfg_attr(not(target_arch = "x86_64"), allow(dead_code))]
 pub struct Avx2(());
 
 impl Avx2 {

@@ -389,7 +389,9 @@ impl Fan {
     /// Tests triangle `t` against the open rays: each ray `k` it blocks gets `out[k]` set and
     /// is closed. Up to [`DIRECT_MAX`] open rays go straight to the watertight test. Counts a lane
     /// test per open ray through the edge test, and a triangle test per ray given the watertight
-    /// test. The caller has excluded the rays' own triangles (the origin's and the light's).
+    /// test. The caller has excluded the rays' own triangles (the origin's and the light's). With
+    /// `simd` (the caller's proof of AVX2, [`Avx2::detect`]) the lane kernels run; without, the
+    /// scalar tests, which answer alike.
     #[inline]
     pub fn test(
         &mut self,
