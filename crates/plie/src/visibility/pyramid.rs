@@ -14,12 +14,14 @@ use crate::visibility::simd::Avx2;
 /// light edge) and the light's own plane, each grown outward by `margin`.
 #[derive(Clone, Debug, Default)]
 pub struct Pyramid {
-    /// Inward unit normals of the side planes (through the apex), for more than four sides.
+    /// Inward unit normals of the side planes (through the apex), for more than four sides (see
+    /// [`Pyramid::sides`]).
     sides: Vec<Vec3>,
-    /// For at most four sides: their normals (`few[..n]`), and the same normals' `x`, `y` and `z`
-    /// in four lanes (a triangle's third side repeated); `None` for more sides.
+    /// For at most four sides: their normals, `few[..n]` (kept in place, not in `sides`).
     few: [Vec3; 4],
     n: usize,
+    /// The same normals' `x`, `y` and `z` in four lanes, for at most four sides (a triangle's third
+    /// side repeated); `None` for more sides (or none).
     lanes: Option<[Vec4; 3]>,
     /// Unit normal of the light plane pointing toward the apex, and the plane's offset.
     cap: (Vec3, f32),

@@ -14,7 +14,7 @@ use crate::scene::LightId;
 /// `occluded_light`, 254x254, 16 rays, `penumbra`, sums over conference-lit, huis-c,
 /// cornell-dragon-100k and cornell-bunny, docs/results.md issue 21 session 27): 2, 4, 8 and 16
 /// (with [`PROBE`] 64) took 1,541.96, 1,545.47, 1,551.07 and 1,559.25 M instructions, against
-/// 1,708.50 M without skipping; 4 loses fewer decided verdicts than 2 for 0.2%.
+/// 1,708.46 M without skipping; 4 loses fewer decided verdicts than 2 for 0.2%.
 const STREAK: u16 = 4;
 
 /// A skipping pair finds its footprints on every this-many-th query. Measured as [`STREAK`] (with

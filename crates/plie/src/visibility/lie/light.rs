@@ -81,7 +81,8 @@ impl LieVisibility<'_> {
             // (its lights come back as umbra or mixed, never lit or listed).
             let crowded = self.own[leaf.idx()].1 as usize > OWN_MAX;
             // Where this leaf's footprints toward the light decided nothing the last few times,
-            // they are not found ([`crate::visibility::verdicts`]): the light goes to the scene.
+            // they are not sought ([`crate::visibility::verdicts`]): the light goes where an
+            // undecided one goes (its shaft or the scene BVH).
             let whole = match sc.verdicts.ask(leaf, rays.light) {
                 Some(slot) => {
                     let poly = &self.scene.lights[rays.light.idx()].vertices;
