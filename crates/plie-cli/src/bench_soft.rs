@@ -276,24 +276,27 @@ pub fn report(r: &SoftResults) -> String {
         }
         let _ = writeln!(s);
         // Whole answers of the P-LIE modes.
-        let _ = writeln!(s, "(point, light) pairs answered whole (umbra / lit), by the short lists gathered under the light's footprints, by the triangles in the shaft of the point's piece of surface, by the light's last blockers (all rays occluded by the blockers of its last walk that found every ray occluded), or by the scene BVH, `grid`:\n");
-        let _ =
-            writeln!(s, "| scene | pairs | whole umbra | whole lit | gathered | shaft | last blockers | scene BVH |");
-        let _ = writeln!(s, "|---|---|---|---|---|---|---|---|");
+        let _ = writeln!(s, "(point, light) pairs answered whole (umbra / lit), by the short lists gathered under the light's footprints, by the triangles in the shaft of the point's piece of surface, by the light's last blockers (all rays occluded by the blockers of its last walk that found every ray occluded), or by the scene BVH, `grid`; and the pairs whose footprints were not sought because they had decided nothing in the last queries of their leaf and light (those go to the shaft, last blockers or scene BVH):\n");
+        let _ = writeln!(
+            s,
+            "| scene | pairs | whole umbra | whole lit | gathered | shaft | last blockers | scene BVH | not sought |"
+        );
+        let _ = writeln!(s, "|---|---|---|---|---|---|---|---|---|");
         for sc in &scenes {
             if let Some(row) = r.rows.iter().find(|x| x.scene == *sc && x.mode == "grid" && x.shadow_rays == n) {
                 let l = row.lights;
                 let pct = |k: u64| 100.0 * k as f64 / l.queries.max(1) as f64;
                 let _ = writeln!(
                     s,
-                    "| {sc} | {} | {:.1}% | {:.1}% | {:.1}% | {:.1}% | {:.1}% | {:.1}% |",
+                    "| {sc} | {} | {:.1}% | {:.1}% | {:.1}% | {:.1}% | {:.1}% | {:.1}% | {:.1}% |",
                     l.queries,
                     pct(l.whole_umbra),
                     pct(l.whole_lit),
                     pct(l.gathered),
                     pct(l.shaft),
                     pct(l.last_blockers),
-                    pct(l.scene)
+                    pct(l.scene),
+                    pct(l.unsought)
                 );
             }
         }

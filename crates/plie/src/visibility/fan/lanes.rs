@@ -497,9 +497,10 @@ pub(super) struct Lanes<'a> {
 /// products is within a few `ε` of the largest one's magnitude.
 const T_MARGIN: f32 = 1e-5;
 
-/// Sets bit `j` of `maybe` unless lane `j` is a sure miss of the triangle with scaled edge normals
-/// `s` (see [`Fan::test`]), or its hit parameter cannot fall in the segment's range (`span`: per
-/// axis, the least and greatest vertex coordinate, taken along the lane's `kz`).
+/// Clears bit `j` of `maybe` (the lanes to decide, set by the caller) where lane `j` is a sure
+/// miss of the triangle with scaled edge normals `s` (see [`Fan::test`]), or its hit parameter
+/// cannot fall in the segment's range (`span`: per axis, the least and greatest vertex coordinate,
+/// taken along the lane's `kz`). Blocks of eight lanes with no bit set are not computed.
 #[inline]
 pub(super) fn misses(s: &[Vec3; 3], span: &[(f32, f32); 3], lanes: &Lanes, maybe: &mut [u64], simd: Option<Avx2>) {
     #[cfg(not(target_arch = "x86_64"))]
@@ -515,8 +516,10 @@ pub(super) fn misses(s: &[Vec3; 3], span: &[(f32, f32); 3], lanes: &Lanes, maybe
 
 /// [`misses`], lane by lane.
 fn misses_scalar(s: &[Vec3; 3], span: &[(f32, f32); 3], lanes: &Lanes, maybe: &mut [u64]) {
-    maybe.fill(0);
     for j in 0..lanes.x.len().min(maybe.len() * 64) {
+        if maybe[j / 64] >> (j % 64) & 1 == 0 {
+            continue;
+        }
         let d = Vec3::new(lanes.x[j], lanes.y[j], lanes.z[j]);
         let l = lanes.len[j];
         let e = [s[0].dot(d), s[1].dot(d), s[2].dot(d)];
@@ -529,8 +532,8 @@ fn misses_scalar(s: &[Vec3; 3], span: &[(f32, f32); 3], lanes: &Lanes, maybe: &m
             let m = T_MARGIN * zlo.abs().max(zhi.abs());
             zlo > 1.0 - SEGMENT_EPS + m || zhi < SEGMENT_EPS - m
         };
-        if !(outside || pos && neg) {
-            maybe[j / 64] |= 1 << (j % 64);
+        if outside || pos && neg {
+            maybe[j / 64] &= !(1 << (j % 64));
         }
     }
 }
@@ -560,9 +563,12 @@ unsafe fn misses_avx(s: &[Vec3; 3], span: &[(f32, f32); 3], lanes: &Lanes, maybe
     let xyz = |v: [f32; 3]| _mm256_castps128_ps256(_mm_setr_ps(v[0], v[1], v[2], 0.0));
     let (lo, hi) = (xyz(span.map(|s| s.0)), xyz(span.map(|s| s.1)));
     let (t_min, t_max, t_margin) = (sp(SEGMENT_EPS), sp(1.0 - SEGMENT_EPS), sp(T_MARGIN));
-    maybe.fill(0);
     let mut j = 0;
     while j < n && j / 64 < maybe.len() {
+        if maybe[j / 64] >> (j % 64) & 0xff == 0 {
+            j += LANES;
+            continue;
+        }
         // SAFETY: j + LANES <= n <= every array's length.
         let (x, y, z, l) = unsafe {
             (
@@ -601,7 +607,7 @@ unsafe fn misses_avx(s: &[Vec3; 3], span: &[(f32, f32); 3], lanes: &Lanes, maybe
             miss = _mm256_or_ps(miss, _mm256_or_ps(far, near));
         }
         let miss = _mm256_movemask_ps(miss) as u64;
-        maybe[j / 64] |= (!miss & 0xff) << (j % 64);
+        maybe[j / 64] &= !((miss & 0xff) << (j % 64));
         j += LANES;
     }
 }
@@ -841,6 +847,54 @@ mod tests {
             }
             assert!(met > 1000, "{met}");
         }
+    }
+
+    /// The eight-lane edge test and the scalar one clear the same lanes of a mask, only lanes of
+    /// the mask, and some (over 128 lanes: two words, with blocks left out of the mask).
+    #[test]
+    fn sure_misses_in_lanes_and_one_by_one_agree() {
+        if Avx2::detect().is_none() {
+            eprintln!("no AVX2 here: only the scalar edge test exists");
+            return;
+        }
+        let mut state = 5u64;
+        let mut r = |scale: f32| {
+            state = crate::render::sampler::mix64(state);
+            ((state >> 40) as f32 / (1u64 << 24) as f32 - 0.5) * scale
+        };
+        let n = 128;
+        let d: Vec<Vec3> = (0..n).map(|_| Vec3::new(r(2.0), r(2.0), 1.0 + r(1.0))).collect();
+        let kz: Vec<u32> = d.iter().map(|&d| crate::geometry::RayTest::major_axis(d) as u32).collect();
+        let (x, y, z): (Vec<f32>, Vec<f32>, Vec<f32>) = d.iter().map(|d| (d.x, d.y, d.z)).collect();
+        let len: Vec<f32> = d.iter().map(|d| d.length()).collect();
+        let sz: Vec<f32> = d.iter().zip(&kz).map(|(d, &k)| 1.0 / d[k as usize]).collect();
+        let lanes = Lanes { x: &x, y: &y, z: &z, len: &len, sz: &sz, kz: &kz };
+        let (mut cleared, mut kept) = (0, 0);
+        for round in 0..500 {
+            // A triangle about the rays' cone, scaled as `Fan::test` scales its edge normals.
+            let (a, b, c) = (
+                Vec3::new(r(2.0), r(2.0), 0.5 + r(0.8)),
+                Vec3::new(r(2.0), r(2.0), 0.5 + r(0.8)),
+                Vec3::new(r(2.0), r(2.0), 0.5 + r(0.8)),
+            );
+            let l1 = |v: Vec3| v.abs().element_sum();
+            let sc = |p: Vec3, q: Vec3| p.cross(q) * (super::super::EDGE_MARGIN * l1(p) * l1(q)).recip();
+            let e = [sc(b, c), sc(c, a), sc(a, b)];
+            let (lo, hi) = (a.min(b).min(c), a.max(b).max(c));
+            let span = [(lo.x, hi.x), (lo.y, hi.y), (lo.z, hi.z)];
+            // Two words; the second leaves whole blocks out.
+            let mask = [mix_bits(round), mix_bits(round + 7) & 0x00ff_ff00_00ff_00ff];
+            let (mut by_lanes, mut one_by_one) = (mask, mask);
+            misses(&e, &span, &lanes, &mut by_lanes, Avx2::detect());
+            misses_scalar(&e, &span, &lanes, &mut one_by_one);
+            assert_eq!(by_lanes, one_by_one, "round {round}");
+            for w in 0..2 {
+                assert_eq!(by_lanes[w] & !mask[w], 0, "round {round}: a lane outside the mask");
+                cleared += (mask[w] & !by_lanes[w]).count_ones();
+                kept += by_lanes[w].count_ones();
+            }
+        }
+        assert!(cleared > 1000 && kept > 100, "{cleared} cleared, {kept} kept");
     }
 
     /// The shear lanes are [`crate::geometry::RayTest::new`]'s, bit for bit, on ordinary, tied,

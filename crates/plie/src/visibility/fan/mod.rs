@@ -454,15 +454,17 @@ impl Fan {
             // coordinate.
             let (lo, hi) = (a.min(b).min(c), a.max(b).max(c));
             let span = [(lo.x, hi.x), (lo.y, hi.y), (lo.z, hi.z)];
+            // The open rays of the mask, less the sure misses.
+            for w in 0..words {
+                self.maybe[w] = self.open[w] & mask(w);
+            }
             if s.iter().all(|v| v.is_finite()) {
                 let [x, y, z, len, sz, ..] = &self.all;
                 let lanes = Lanes { x, y, z, len, sz, kz: &self.all_kz };
-                misses(&s, &span, &lanes, &mut self.maybe, simd);
-            } else {
-                self.maybe.fill(u64::MAX);
+                misses(&s, &span, &lanes, &mut self.maybe[..words], simd);
             }
             for w in 0..words {
-                let bits = self.maybe[w] & self.open[w] & mask(w);
+                let bits = self.maybe[w];
                 self.exact(tri, w, bits, rays, out, ctx, simd);
             }
         }
