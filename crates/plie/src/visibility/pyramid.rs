@@ -27,6 +27,14 @@ pub struct Pyramid {
     cap: (Vec3, f32),
     apex: Vec3,
     margin: f32,
+    /// The light's corners relative to the apex, in four lanes per axis (a triangle's last corner
+    /// twice), for lights of at most four corners ([`Pyramid::beside`]); `None` for more.
+    corners: Option<[Vec4; 3]>,
+    /// How far the light's samples may lie outside its polygon but for rounding ([`stray_of`]).
+    stray: f32,
+    /// The corners' lengths (the same lanes) and how far a sample's direction may lie from the
+    /// corners' cone ([`Pyramid::outside_cone`]), computed on first use.
+    cone: Option<(Vec4, f32)>,
 }
 
 /// What [`Pyramid::set_from`] needs of a light of at most four corners, computed once per light
@@ -46,6 +54,8 @@ pub struct PyramidBasis {
     cap: (Vec3, f32),
     /// Corners: 3 or 4.
     n: usize,
+    /// How far the light's samples may lie outside its polygon but for rounding ([`stray_of`]).
+    stray: f32,
 }
 
 /// The margin every per-light query grows its pyramid by: ten times the scene's tolerance
@@ -63,8 +73,23 @@ impl PyramidBasis {
             return None;
         }
         let (p, q) = corner_lanes(v);
-        Some(PyramidBasis { p, q, v0: v[0], centre: light.center(), cap: (light.normal, light.normal.dot(v[0])), n })
+        let (centre, cap) = (light.center(), (light.normal, light.normal.dot(v[0])));
+        Some(PyramidBasis { p, q, v0: v[0], centre, cap, n, stray: stray_of(light) })
     }
+}
+
+/// How far the samples of `light` may lie outside its polygon, but for rounding: a parallelogram is
+/// sampled over `v0`, `v1`, `v3` and `v1 + v3 - v0` ([`Light::sample`]), which is `v2` only up to
+/// the deviation the light's check accepts; each such sample is within that deviation of the
+/// polygon (the bilinear map's point of the polygon differs by `u v (v1 + v3 - v0 - v2)`). Other
+/// polygons are sampled inside their triangles: 0.
+fn stray_of(light: &Light) -> f32 {
+    let v = &light.vertices;
+    if light.parallelogram_edges().is_none() {
+        return 0.0;
+    }
+    let d = v[1].as_dvec3() + v[3].as_dvec3() - v[0].as_dvec3() - v[2].as_dvec3();
+    (d.length() * 1.01) as f32
 }
 
 /// The corners `p` of the edges of a polygon of three or four corners `v`, and the corners `q` they
@@ -94,8 +119,12 @@ impl Pyramid {
     /// [`Pyramid::set`] for a light of at most four corners from its precomputed `basis`: the same
     /// operations on the same values, so the same pyramid, bit for bit.
     pub fn set_from(&mut self, x: Vec3, basis: &PyramidBasis, margin: f32) -> bool {
-        self.start(x, basis.cap, basis.v0, margin)
-            && self.set_sides_from_lanes(x, (&basis.p, &basis.q), basis.centre - x, basis.n)
+        let ok = self.start(x, basis.cap, basis.v0, margin)
+            && self.set_sides_from_lanes(x, (&basis.p, &basis.q), basis.centre - x, basis.n);
+        if ok {
+            self.stray = basis.stray;
+        }
+        ok
     }
 
     /// Empties the pyramid and sets its apex `x`, margin and cap (the light's unit normal and
@@ -104,6 +133,8 @@ impl Pyramid {
     fn start(&mut self, x: Vec3, cap: (Vec3, f32), v0: Vec3, margin: f32) -> bool {
         self.sides.clear();
         self.lanes = None;
+        self.corners = None;
+        (self.stray, self.cone) = (0.0, None);
         self.n = 0;
         self.apex = x;
         self.margin = margin;
@@ -124,7 +155,11 @@ impl Pyramid {
         // recomputed, within rounding of the vertex): the polygon's edges, grown by the margin.
         let toward_centre = light.center() - x;
         if v.len() <= 4 {
-            self.set_sides_lanes(x, v, toward_centre)
+            let ok = self.set_sides_lanes(x, v, toward_centre);
+            if ok {
+                self.stray = stray_of(light);
+            }
+            ok
         } else {
             self.set_sides(x, v, toward_centre)
         }
@@ -194,6 +229,7 @@ impl Pyramid {
         ];
         self.n = n;
         self.lanes = Some([sx, sy, sz]);
+        self.corners = Some([px, py, pz]);
         true
     }
 
@@ -201,6 +237,78 @@ impl Pyramid {
     /// query uses: ten times the scene's tolerance ([`TOLERANCE_REL`] of its size).
     pub fn set_in(&mut self, scene: &Scene, x: Vec3, light: LightId) -> bool {
         self.set(x, &scene.lights[light.idx()], margin_of(scene))
+    }
+
+    /// True if the plane of the triangle `(a, b, c)` (given relative to the apex) has the apex and
+    /// every corner of the light on one side, each farther than the margin: then every segment
+    /// from the apex to the light (within the margin) lies on that side, at least the margin from
+    /// the triangle, as the sides' cull ([`Pyramid::culls`]) leaves it. The plane is computed in
+    /// `f64` from the `f32` vertices (their differences and the products of those are exact there,
+    /// but for coordinates of very different size), and a sliver (its normal shorter than `1e-6`
+    /// times the product of its edges, so that a rounding could tilt it) is never beside. False
+    /// for lights of more than four corners.
+    #[inline(always)]
+    pub(crate) fn beside(&self, a: Vec3, b: Vec3, c: Vec3) -> bool {
+        let Some([cx, cy, cz]) = self.corners else {
+            return false;
+        };
+        let (a, e, f) = (a.as_dvec3(), (b.as_dvec3() - a.as_dvec3()), (c.as_dvec3() - a.as_dvec3()));
+        let n = e.cross(f);
+        let nn = n.length_squared();
+        // (Written so that a NaN is never beside.)
+        let wide = nn > 1e-12 * e.length_squared() * f.length_squared();
+        if !wide {
+            return false;
+        }
+        let k = n.dot(a);
+        let m = f64::from(self.margin) * f64::from(self.margin) * nn;
+        // The apex's side (its offset is `-k`), then each corner's on the same side.
+        let s0 = -k;
+        let clear = s0 * s0 > m;
+        if !clear {
+            return false;
+        }
+        let (cx, cy, cz) = (cx.as_dvec4(), cy.as_dvec4(), cz.as_dvec4());
+        let s = cx * n.x + cy * n.y + cz * n.z - glam::DVec4::splat(k);
+        let same = if s0 > 0.0 { s.cmpgt(glam::DVec4::ZERO) } else { s.cmplt(glam::DVec4::ZERO) };
+        same.all() && (s * s).cmpgt(glam::DVec4::splat(m)).all()
+    }
+
+    /// True if every sample of the light lies clearly outside the cone from the apex over a
+    /// triangle, as the fan's edge test decides each ray ([`super::fan`]): `s` are the triangle's
+    /// three edge normals through the apex, scaled by the inverse of their margins, so that a ray
+    /// of direction `d` is a sure miss where one `s_i . d` exceeds `|d|` and another is below
+    /// `-|d|`. Each edge function is linear in `d`, so where every corner `c` gives
+    /// `s_i . c > 1.1 (|c| + r (1 + |s_i|))` (and another edge the same below), so does every
+    /// direction in the corners' cone, and a sample's direction strays from that cone by at most
+    /// `r` (the field `reach`); the factor 1.1 covers the rounding of `s_i . c` (at most
+    /// `3 ε |s_i| |c|`, and `|s_i| <= 1 / (256 ε)`). False for lights of more than four corners.
+    #[inline(always)]
+    pub(crate) fn outside_cone(&mut self, s: &[Vec3; 3]) -> bool {
+        let Some([cx, cy, cz]) = self.corners else {
+            return false;
+        };
+        let (len, reach) = *self.cone.get_or_insert_with(|| {
+            // A sample's direction `fl(fl(y) - x)` lies within a few roundings of the world
+            // coordinates of the light and of `x` from the corners' cone (a sample
+            // `v0 + e1 u + e3 v` rounds by at most about `20 ε` of the largest coordinate, its
+            // direction and the corners' by `ε` of theirs; the Euclidean norm is at most `sqrt 3`
+            // times that): 64 roundings of the L1 norms (the corners' world coordinates within a
+            // rounding of `c + x`), and what a parallelogram's samples may stray beyond its
+            // polygon ([`stray_of`]).
+            let x = self.apex;
+            let world = (cx + Vec4::splat(x.x)).abs() + (cy + Vec4::splat(x.y)).abs() + (cz + Vec4::splat(x.z)).abs();
+            let l1 = world.max_element() + x.abs().element_sum();
+            ((cx * cx + cy * cy + cz * cz).sqrt(), 64.0 * f32::EPSILON * l1 + self.stray)
+        });
+        let (mut above, mut below) = (false, false);
+        for si in s {
+            let e = cx * si.x + cy * si.y + cz * si.z;
+            let t = (len + Vec4::splat(reach * (1.0 + si.length()))) * 1.1;
+            above |= e.cmpgt(t).all();
+            below |= e.cmplt(-t).all();
+        }
+        above && below
     }
 
     /// True if no segment from the apex to a point of the light (within the margin) can meet
@@ -384,7 +492,10 @@ mod tests {
                 let bits = |p: &Pyramid| {
                     let sides: Vec<[u32; 3]> = p.sides().iter().map(|s| s.to_array().map(f32::to_bits)).collect();
                     let lanes = p.lanes.map(|l| l.map(|v| v.to_array().map(f32::to_bits)));
-                    (sides, lanes, p.cap.0.to_array().map(f32::to_bits), p.cap.1.to_bits(), p.apex, p.margin)
+                    let corners = p.corners.map(|c| c.map(|v| v.to_array().map(f32::to_bits)));
+                    let reach = (p.stray.to_bits(), p.cone.is_some());
+                    let cap = (p.cap.0.to_array().map(f32::to_bits), p.cap.1.to_bits());
+                    (sides, lanes, cap, p.apex, p.margin, corners, reach)
                 };
                 assert_eq!(bits(&a), bits(&b), "{x}");
                 defined += usize::from(ok);
@@ -393,6 +504,60 @@ mod tests {
         assert!(defined > 5_000 && defined < 10_000, "{defined}");
         let pentagon = [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.5, 1.5], [0.0, 1.0]].map(|[a, b]| Vec3::new(a, 2.0, b));
         assert!(PyramidBasis::of(&Light::new(pentagon.to_vec(), Vec3::ONE, vec![]).unwrap()).is_none());
+    }
+
+    /// A triangle [`Pyramid::beside`] the pyramid meets no segment from the apex to a sample of the
+    /// light (the watertight test, on the light's corners and random points of it): random
+    /// triangles around the pyramid, some touching the apex or the light, some slivers; both
+    /// answers occur.
+    #[test]
+    fn beside_triangles_meet_no_segment() {
+        use crate::geometry::RayTest;
+        use crate::visibility::query::SEGMENT_EPS;
+        let (o, e1, e3) = (Vec3::new(0.13, 2.0, 0.07), Vec3::new(0.31, 0.02, 0.97), Vec3::new(0.93, -0.01, -0.29));
+        let light = Light::new(vec![o, o + e3, o + e1 + e3, o + e1], Vec3::ONE, vec![]).unwrap();
+        let basis = PyramidBasis::of(&light).unwrap();
+        let mut rng = Rng::stream(12, 0, 0, 0);
+        let (mut beside, mut tested) = (0, 0);
+        for i in 0..4_000 {
+            let x = Vec3::new(rng.next_f32() * 3.0 - 1.0, rng.next_f32() * 1.5, rng.next_f32() * 3.0 - 1.0);
+            let mut p = Pyramid::default();
+            if !p.set_from(x, &basis, 1e-4) {
+                continue;
+            }
+            let samples: Vec<Vec3> = (0..32)
+                .map(|k| match k {
+                    0..4 => light.vertices[k],
+                    _ => o + e1 * rng.next_f32() + e3 * rng.next_f32(),
+                })
+                .collect();
+            for j in 0..8 {
+                let mut v =
+                    || Vec3::new(rng.next_f32() * 4.0 - 1.5, rng.next_f32() * 3.0 - 0.5, rng.next_f32() * 4.0 - 1.5);
+                let (mut a, b, mut c) = (v(), v(), v());
+                match (i + j) % 4 {
+                    // Touching the apex.
+                    0 => a = x,
+                    // Touching the light.
+                    1 => a = samples[4],
+                    // A sliver.
+                    2 => c = a + (b - a) * 0.37 + Vec3::splat(1e-6),
+                    _ => {}
+                }
+                let tri = Triangle::new(a, b, c);
+                if !p.beside(a - x, b - x, c - x) {
+                    continue;
+                }
+                beside += 1;
+                for &y in &samples {
+                    tested += 1;
+                    let test = RayTest::new(x, y - x, SEGMENT_EPS, 1.0 - SEGMENT_EPS);
+                    assert!(test.hit(&tri).is_none(), "apex {x}, sample {y}, {tri:?}");
+                }
+            }
+        }
+        assert!(beside > 2_000 && beside < 30_000, "{beside} of 32,000");
+        assert!(tested > 0);
     }
 
     /// Eight boxes at once decide as one at a time, on random boxes around the pyramid.
