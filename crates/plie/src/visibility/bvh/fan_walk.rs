@@ -120,6 +120,7 @@ impl Bvh {
         if self.cw.nodes.is_empty() || fan.live() == 0 {
             return;
         }
+        fan.ready_boxes(simd);
         let apex = self.to_local(fan.origin());
         let to_world = 1.0 / self.scale;
         walk.nodes.clear();

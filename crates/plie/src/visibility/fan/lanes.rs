@@ -158,15 +158,17 @@ fn shear_block(
 }
 
 /// The per-ray values of [`super::Fan::set`] for the blocks of eight points of `ys` (the fan's
-/// targets, from `x`) in one pass: the directions `y - x` (as `Vec3`'s subtraction), [`RayBlock`]
-/// and [`shear_block`], into `all` (`dx, dy, dz, len, sz, ix, iy, iz`), `kz`, the shears `s` and
-/// their axes `k`, each lane as the scalar code computes it. Returns how many points it did: all
-/// of them where the arrays have room for whole blocks, else a multiple of eight (the caller does
-/// the rest).
+/// targets, from `x`) in one pass: the directions `y - x` (as `Vec3`'s subtraction), their lengths,
+/// `1 / d[kz]` ([`RayBlock`]) into `all` (`dx, dy, dz, len, sz`) and `kz`, and with `ALL` also the
+/// inverse directions (`all`'s `ix, iy, iz`) and [`shear_block`] (the shears `s` and their axes
+/// `k`), each lane as the scalar code computes it. Without `ALL` those are left to
+/// [`inverse_lanes_avx`] and [`shear_lanes_avx`], on first use. Returns how many points it did:
+/// all of them where the arrays have room for whole blocks, else a multiple of eight (the caller
+/// does the rest).
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx,avx2")]
 #[inline]
-pub(super) unsafe fn fan_lanes_avx(
+pub(super) unsafe fn fan_lanes_avx<const ALL: bool>(
     ys: &[Vec3],
     x: Vec3,
     all: &mut [Vec<f32>; 8],
@@ -180,11 +182,13 @@ pub(super) unsafe fn fan_lanes_avx(
     for v in all.iter() {
         room = room.min(v.len());
     }
-    for v in s.iter() {
-        room = room.min(v.len());
-    }
-    for v in k.iter() {
-        room = room.min(v.len());
+    if ALL {
+        for v in s.iter() {
+            room = room.min(v.len());
+        }
+        for v in k.iter() {
+            room = room.min(v.len());
+        }
     }
     let n = ys.len().min(room) / LANES * LANES;
     let (sx, sy, sz) = (_mm256_set1_ps(x.x), _mm256_set1_ps(x.y), _mm256_set1_ps(x.z));
@@ -195,22 +199,25 @@ pub(super) unsafe fn fan_lanes_avx(
     let mut block = |p: *const Vec3, j: usize| unsafe {
         let (px, py, pz) = points_block(p.cast::<f32>());
         let (x, y, z) = (_mm256_sub_ps(px, sx), _mm256_sub_ps(py, sy), _mm256_sub_ps(pz, sz));
+        // (Without `ALL`, the inverse directions of `r` are not stored, so not computed.)
         let r = ray_block(x, y, z);
-        let (sxv, syv, kxv, kyv) = shear_block([x, y, z], r.kz, r.sz);
         let put = |v: &mut Vec<f32>, a: __m256| _mm256_storeu_ps(v.as_mut_ptr().add(j), a);
         put(dx, x);
         put(dy, y);
         put(dz, z);
         put(len, r.len);
         put(szs, r.sz);
-        put(ix, r.ix);
-        put(iy, r.iy);
-        put(iz, r.iz);
-        put(shx, sxv);
-        put(shy, syv);
         _mm256_storeu_si256(kz.as_mut_ptr().add(j).cast(), r.kz);
-        _mm256_storeu_si256(kx.as_mut_ptr().add(j).cast(), kxv);
-        _mm256_storeu_si256(ky.as_mut_ptr().add(j).cast(), kyv);
+        if ALL {
+            let (sxv, syv, kxv, kyv) = shear_block([x, y, z], r.kz, r.sz);
+            put(ix, r.ix);
+            put(iy, r.iy);
+            put(iz, r.iz);
+            put(shx, sxv);
+            put(shy, syv);
+            _mm256_storeu_si256(kx.as_mut_ptr().add(j).cast(), kxv);
+            _mm256_storeu_si256(ky.as_mut_ptr().add(j).cast(), kyv);
+        }
     };
     let mut j = 0;
     while j < n {
@@ -228,6 +235,67 @@ pub(super) unsafe fn fan_lanes_avx(
         j = ys.len();
     }
     j
+}
+
+/// The inverse directions ([`inverse`], as [`RayBlock`] computes them) of the directions in `all`
+/// (`dx, dy, dz`), into its `ix, iy, iz`, for the whole blocks of eight lanes the arrays hold.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx,avx2")]
+#[inline]
+pub(super) unsafe fn inverse_lanes_avx(all: &mut [Vec<f32>; 8]) {
+    use std::arch::x86_64::*;
+    let mut room = usize::MAX;
+    for v in all.iter() {
+        room = room.min(v.len());
+    }
+    let [dx, dy, dz, _, _, ix, iy, iz] = all;
+    let mut j = 0;
+    while j + LANES <= room {
+        // SAFETY: j + LANES <= room, the length of every array.
+        unsafe {
+            let get = |v: &Vec<f32>| _mm256_loadu_ps(v.as_ptr().add(j));
+            // (Only the inverse directions of `r` are stored, so only they are computed.)
+            let r = ray_block(get(dx), get(dy), get(dz));
+            let put = |v: &mut Vec<f32>, a: __m256| _mm256_storeu_ps(v.as_mut_ptr().add(j), a);
+            put(ix, r.ix);
+            put(iy, r.iy);
+            put(iz, r.iz);
+        }
+        j += LANES;
+    }
+}
+
+/// The rest of the watertight test's shear ([`shear_block`]) of the directions in `all` (`dx, dy,
+/// dz`, with `sz` and the axes `kz`): `sx`, `sy` into `s` and the axes `kx`, `ky` into `k`, for
+/// the whole blocks of eight lanes the arrays hold.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx,avx2")]
+#[inline]
+pub(super) unsafe fn shear_lanes_avx(all: &[Vec<f32>; 8], kz: &[u32], s: &mut [Vec<f32>; 2], k: &mut [Vec<u32>; 2]) {
+    use std::arch::x86_64::*;
+    let mut room = kz.len();
+    for v in all.iter().chain(s.iter()) {
+        room = room.min(v.len());
+    }
+    for v in k.iter() {
+        room = room.min(v.len());
+    }
+    let [dx, dy, dz, _, szs, ..] = all;
+    let ([shx, shy], [kx, ky]) = (s, k);
+    let mut j = 0;
+    while j + LANES <= room {
+        // SAFETY: j + LANES <= room, the length of every array.
+        unsafe {
+            let get = |v: &Vec<f32>| _mm256_loadu_ps(v.as_ptr().add(j));
+            let kzv = _mm256_loadu_si256(kz.as_ptr().add(j).cast());
+            let (sxv, syv, kxv, kyv) = shear_block([get(dx), get(dy), get(dz)], kzv, get(szs));
+            _mm256_storeu_ps(shx.as_mut_ptr().add(j), sxv);
+            _mm256_storeu_ps(shy.as_mut_ptr().add(j), syv);
+            _mm256_storeu_si256(kx.as_mut_ptr().add(j).cast(), kxv);
+            _mm256_storeu_si256(ky.as_mut_ptr().add(j).cast(), kyv);
+        }
+        j += LANES;
+    }
 }
 
 /// The coordinates of the eight points (24 floats) at `p`, taken apart with shuffles: `(x, y, z)`.
@@ -746,14 +814,30 @@ mod tests {
             let mut kz = vec![0u32; room];
             let (mut s, mut k) = ([vec![0.0; room], vec![0.0; room]], [vec![0u32; room], vec![0u32; room]]);
             // SAFETY: AVX2 is available (checked above).
-            let done = unsafe { fan_lanes_avx(&ys, Vec3::ZERO, &mut all, &mut kz, &mut s, &mut k) };
+            let done = unsafe { fan_lanes_avx::<true>(&ys, Vec3::ZERO, &mut all, &mut kz, &mut s, &mut k) };
             assert_eq!(done, n);
+            // The values left to first use, computed then: the same bits.
+            let (mut later, mut kz_later) = (std::array::from_fn(|_| vec![0.0; room]), vec![0u32; room]);
+            let (mut s_later, mut k_later) = ([vec![0.0; room], vec![0.0; room]], [vec![0u32; room], vec![0u32; room]]);
+            // SAFETY: as above.
+            unsafe {
+                let done =
+                    fan_lanes_avx::<false>(&ys, Vec3::ZERO, &mut later, &mut kz_later, &mut s_later, &mut k_later);
+                assert_eq!(done, n);
+                inverse_lanes_avx(&mut later);
+                shear_lanes_avx(&later, &kz_later, &mut s_later, &mut k_later);
+            }
+            let bits = |v: &[f32]| -> Vec<u32> { v[..n].iter().map(|f| f.to_bits()).collect() };
+            for (a, b) in all.iter().zip(&later).chain(s.iter().zip(&s_later)) {
+                assert_eq!(bits(a), bits(b));
+            }
+            assert_eq!((&kz[..n], &k[0][..n], &k[1][..n]), (&kz_later[..n], &k_later[0][..n], &k_later[1][..n]));
             // Without room for the last block, only the whole blocks.
             let mut short: [Vec<f32>; 8] = std::array::from_fn(|_| vec![0.0; n]);
             let (mut s2, mut k2, mut kz2) =
                 ([vec![0.0; n], vec![0.0; n]], [vec![0u32; n], vec![0u32; n]], vec![0u32; n]);
             // SAFETY: as above.
-            let whole = unsafe { fan_lanes_avx(&ys, Vec3::ZERO, &mut short, &mut kz2, &mut s2, &mut k2) };
+            let whole = unsafe { fan_lanes_avx::<true>(&ys, Vec3::ZERO, &mut short, &mut kz2, &mut s2, &mut k2) };
             assert_eq!(whole, n / LANES * LANES);
             for (j, &d) in ys.iter().enumerate() {
                 let a = d.abs();
@@ -786,7 +870,7 @@ mod tests {
             let (mut all, mut kz) = (std::array::from_fn(|_| vec![0.0; 64]), vec![0u32; 64]);
             let (mut s, mut k) = ([vec![0.0; 64], vec![0.0; 64]], [vec![0u32; 64], vec![0u32; 64]]);
             // SAFETY: AVX2 is available (checked above).
-            assert_eq!(unsafe { fan_lanes_avx(&ys, x, &mut all, &mut kz, &mut s, &mut k) }, 64);
+            assert_eq!(unsafe { fan_lanes_avx::<true>(&ys, x, &mut all, &mut kz, &mut s, &mut k) }, 64);
             for (j, &y) in ys.iter().enumerate() {
                 let d = y - x;
                 assert_eq!(

@@ -42,9 +42,9 @@ pub(crate) use lanes::nonzero_bytes;
 mod lanes;
 
 #[cfg(target_arch = "x86_64")]
-use lanes::fan_lanes_avx;
-#[cfg(target_arch = "x86_64")]
 use lanes::{exact_avx, vertices_rel, Shear};
+#[cfg(target_arch = "x86_64")]
+use lanes::{fan_lanes_avx, inverse_lanes_avx, shear_lanes_avx};
 use lanes::{inverse, meets_boxes, misses, ray_meets_boxes, shear_lanes, BoxLanes, Lanes};
 
 /// Relative margin of the edge functions. The watertight test's sheared edge function of an edge
@@ -76,6 +76,13 @@ pub struct Fan {
     shear_s: [Vec<f32>; 2],
     shear_k: [Vec<u32>; 2],
     built: Vec<u64>,
+    /// Whether the inverse directions (the last three of `all`) and the shears are computed for
+    /// the current rays: where the CPU has AVX2, [`Fan::set`] leaves them to the first box test
+    /// ([`Fan::ready_boxes`]) and the first watertight test, which many fans never run (a fan
+    /// tested against a shaft's or a list's triangles tests no box; most triangles a fan meets are
+    /// decided without the watertight test).
+    inverse_ready: bool,
+    shears_ready: bool,
     /// Bit `k` of word `k / 64`: ray `k` is still open (not found occluded).
     open: Vec<u64>,
     /// Bit per ray: the fast test could not prove a miss for the current triangle.
@@ -136,8 +143,17 @@ impl Fan {
         #[cfg(target_arch = "x86_64")]
         if simd.is_some() {
             // SAFETY: AVX2 is available (the proof).
+            // A fan of at most `DIRECT_MAX` rays gives every triangle it meets to the watertight
+            // test, so it needs its shears anyway: all at once costs less (measured,
+            // docs/results.md issue 21 session 29); a larger one leaves the inverse directions
+            // and the shears to first use.
+            let (all, kz, s, k) = (&mut self.all, &mut self.all_kz, &mut self.shear_s, &mut self.shear_k);
             done = unsafe {
-                fan_lanes_avx(rays.targets, x, &mut self.all, &mut self.all_kz, &mut self.shear_s, &mut self.shear_k)
+                if n <= DIRECT_MAX as usize {
+                    fan_lanes_avx::<true>(rays.targets, x, all, kz, s, k)
+                } else {
+                    fan_lanes_avx::<false>(rays.targets, x, all, kz, s, k)
+                }
             };
         }
         if done < n {
@@ -164,7 +180,9 @@ impl Fan {
                 [&mut kx[done..n], &mut ky[done..n]],
             );
         }
-        // The padding lanes: zero (a zero direction meets no box and no triangle's cone).
+        // The padding lanes: zero (a zero direction meets no box and no triangle's cone). (Those
+        // of the inverse directions and shears computed on first use hold what the zero direction
+        // gives them; no test reads a padding lane but under a mask of the fan's rays.)
         if padded > n {
             for v in self.all.iter_mut().chain(&mut self.shear_s) {
                 v[n..].fill(0.0);
@@ -186,6 +204,51 @@ impl Fan {
         }
         self.live = n;
         self.blockers = [u32::MAX; BLOCKERS];
+        // Without AVX2 the loop above computed everything.
+        let ready = simd.is_none() || n <= DIRECT_MAX as usize;
+        (self.inverse_ready, self.shears_ready) = (ready, ready);
+    }
+
+    /// Computes the inverse directions of the current rays if [`Fan::set`] left them: a walk calls
+    /// this before its first box test ([`Fan::meets8`], [`Fan::ray_meets8`]).
+    #[inline(always)]
+    pub(crate) fn ready_boxes(&mut self, simd: Option<Avx2>) {
+        if !self.inverse_ready {
+            self.make_inverse(simd);
+        }
+    }
+
+    /// The body of [`Fan::ready_boxes`] (left by [`Fan::set`] only where the CPU has AVX2).
+    fn make_inverse(&mut self, simd: Option<Avx2>) {
+        #[cfg(target_arch = "x86_64")]
+        if simd.is_some() {
+            // SAFETY: AVX2 is available (the proof).
+            unsafe { inverse_lanes_avx(&mut self.all) };
+        }
+        #[cfg(not(target_arch = "x86_64"))]
+        let _ = simd;
+        self.inverse_ready = true;
+    }
+
+    /// Computes the shears of the current rays if [`Fan::set`] left them (before a watertight
+    /// test).
+    #[inline(always)]
+    fn ready_shears(&mut self, simd: Option<Avx2>) {
+        if !self.shears_ready {
+            self.make_shears(simd);
+        }
+    }
+
+    /// The body of [`Fan::ready_shears`].
+    fn make_shears(&mut self, simd: Option<Avx2>) {
+        #[cfg(target_arch = "x86_64")]
+        if simd.is_some() {
+            // SAFETY: AVX2 is available (the proof).
+            unsafe { shear_lanes_avx(&self.all, &self.all_kz, &mut self.shear_s, &mut self.shear_k) };
+        }
+        #[cfg(not(target_arch = "x86_64"))]
+        let _ = simd;
+        self.shears_ready = true;
     }
 
     /// The first triangles (up to [`BLOCKERS`]) that closed a ray since [`Fan::set`], `u32::MAX`
@@ -240,6 +303,7 @@ impl Fan {
         if bits == 0 {
             return;
         }
+        self.ready_shears(simd);
         ctx.stats.triangle_tests += u64::from(bits.count_ones());
         let mut one_by_one = bits;
         let mut hits = 0u64;
@@ -326,6 +390,7 @@ impl Fan {
         // The caller's slices say how many words (so a caller that knows it lets the compiler know).
         let w = within.len();
         debug_assert_eq!(w, self.open.len());
+        debug_assert!(self.inverse_ready);
         let mut hit = 0u8;
         let mut out = [0u64; 8];
         for i in 0..w {
@@ -443,6 +508,8 @@ impl Fan {
         } else {
             let x = self.origin;
             let (a, b, c) = (tri.v[0] - x, tri.v[1] - x, tri.v[2] - x);
+            // (Counted as the lanes' test, which the whole light's tests below stand in for.)
+            ctx.stats.lane_tests += self.live as u64;
             // A triangle whose plane has the apex and the whole light on one side meets no ray.
             if self.pyramid.beside(a, b, c) {
                 return;
@@ -463,7 +530,6 @@ impl Fan {
                 if self.pyramid.outside_cone(&s) {
                     return;
                 }
-                ctx.stats.lane_tests += self.live as u64;
                 let [x, y, z, len, sz, ..] = &self.all;
                 let lanes = Lanes { x, y, z, len, sz, kz: &self.all_kz };
                 misses(&s, &span, &lanes, &mut self.maybe[..words], simd);
