@@ -35,6 +35,9 @@ pub struct Pyramid {
     /// The corners' lengths (the same lanes) and how far a sample's direction may lie from the
     /// corners' cone ([`Pyramid::outside_cone`]), computed on first use.
     cone: Option<(Vec4, f32)>,
+    /// The pyramid's bounding box relative to the apex (the apex and the light's corners), grown
+    /// by the margin, where [`Pyramid::bound`] computed it.
+    bounds: Option<(Vec3, Vec3)>,
 }
 
 /// What [`Pyramid::set_from`] needs of a light of at most four corners, computed once per light
@@ -135,6 +138,7 @@ impl Pyramid {
         self.lanes = None;
         self.corners = None;
         (self.stray, self.cone) = (0.0, None);
+        self.bounds = None;
         self.n = 0;
         self.apex = x;
         self.margin = margin;
@@ -239,6 +243,18 @@ impl Pyramid {
         self.set(x, &scene.lights[light.idx()], margin_of(scene))
     }
 
+    /// Computes the pyramid's bounding box (where it keeps the light's corners), so that
+    /// [`Pyramid::culls_rel8`] also culls the boxes outside it: a fan of many rays asks for it
+    /// before its walk ([`super::fan::Fan::ready_boxes`]); for a few rays it costs more than it
+    /// saves (measured, docs/results.md issue 21 session 29).
+    pub(crate) fn bound(&mut self) {
+        if let Some([px, py, pz]) = self.corners {
+            let lo = Vec3::new(px.min_element(), py.min_element(), pz.min_element()).min(Vec3::ZERO);
+            let hi = Vec3::new(px.max_element(), py.max_element(), pz.max_element()).max(Vec3::ZERO);
+            self.bounds = Some((lo - Vec3::splat(self.margin), hi + Vec3::splat(self.margin)));
+        }
+    }
+
     /// True if the plane of the triangle `(a, b, c)` (given relative to the apex) has the apex and
     /// every corner of the light on one side, each farther than the margin: then every segment
     /// from the apex to the light (within the margin) lies on that side, at least the margin from
@@ -339,8 +355,8 @@ impl Pyramid {
     }
 
     /// True if no segment of the pyramid can meet anything in the box `[lo, hi]`, given relative to
-    /// the apex. Only the side planes are tested. (The walks use [`Pyramid::culls_rel8`]; this is
-    /// its reference.)
+    /// the apex. Only the side planes (and, where [`Pyramid::bound`] computed it, the bounding box)
+    /// are tested. (The walks use [`Pyramid::culls_rel8`]; this is its reference.)
     #[cfg(test)]
     pub fn culls_rel(&self, lo: Vec3, hi: Vec3) -> bool {
         let m = self.margin;
@@ -349,15 +365,16 @@ impl Pyramid {
             let far =
                 |s: Vec4, lo: f32, hi: f32| Vec4::select(s.cmpge(Vec4::ZERO), Vec4::splat(hi), Vec4::splat(lo)) * s;
             let d = far(sx, lo.x, hi.x) + far(sy, lo.y, hi.y) + far(sz, lo.z, hi.z);
-            return d.cmplt(Vec4::splat(-m)).any();
+            let outside = self.bounds.is_some_and(|(bl, bh)| lo.cmpgt(bh).any() || hi.cmplt(bl).any());
+            return d.cmplt(Vec4::splat(-m)).any() || outside;
         }
         self.sides().iter().any(|s| s.dot(Vec3::select(s.cmpge(Vec3::ZERO), hi, lo)) < -m)
     }
 
     /// Which of eight boxes, given relative to the apex as lanes (`lo[axis][c]`, `hi[axis][c]` for
     /// box `c`), no segment of the pyramid can meet: bit `c` is set if box `c` lies beyond a side
-    /// plane (the corner farthest along its normal still beyond it by the margin). Only the side
-    /// planes are tested.
+    /// plane (the corner farthest along its normal still beyond it by the margin) or, where
+    /// [`Pyramid::bound`] computed it, outside the pyramid's bounding box.
     #[inline(always)]
     pub(crate) fn culls_rel8(&self, lo: &[[f32; 8]; 3], hi: &[[f32; 8]; 3], simd: Option<Avx2>) -> u8 {
         #[cfg(not(target_arch = "x86_64"))]
@@ -374,6 +391,13 @@ impl Pyramid {
             let (fx, fy, fz) = (far(0), far(1), far(2));
             for c in 0..8 {
                 culled[c] |= u32::from(s.x * fx[c] + s.y * fy[c] + s.z * fz[c] < m);
+            }
+        }
+        if let Some((bl, bh)) = self.bounds {
+            for k in 0..3 {
+                for c in 0..8 {
+                    culled[c] |= u32::from(lo[k][c] > bh[k] || hi[k][c] < bl[k]);
+                }
             }
         }
         (0..8).fold(0, |bits, c| bits | (culled[c] as u8) << c)
@@ -400,6 +424,15 @@ impl Pyramid {
                 _mm256_mul_ps(_mm256_set1_ps(s.z), fz),
             );
             culled = _mm256_or_ps(culled, _mm256_cmp_ps::<_CMP_LT_OQ>(d, m));
+        }
+        // Boxes outside the pyramid's bounding box.
+        if let Some((bl, bh)) = self.bounds {
+            for k in 0..3 {
+                // SAFETY: eight floats each.
+                let (l, h) = unsafe { (_mm256_loadu_ps(lo[k].as_ptr()), _mm256_loadu_ps(hi[k].as_ptr())) };
+                culled = _mm256_or_ps(culled, _mm256_cmp_ps::<_CMP_GT_OQ>(l, _mm256_set1_ps(bh[k])));
+                culled = _mm256_or_ps(culled, _mm256_cmp_ps::<_CMP_LT_OQ>(h, _mm256_set1_ps(bl[k])));
+            }
         }
         _mm256_movemask_ps(culled) as u8
     }
@@ -577,6 +610,8 @@ mod tests {
         let mut p = Pyramid::default();
         let apex = Vec3::new(0.3, 0.0, 0.4);
         assert!(p.set(apex, &light, 1e-4));
+        // With the bounding box (which culls the boxes above the light and below the apex).
+        p.bound();
         let mut rng = Rng::stream(8, 0, 0, 0);
         let mut culled = 0;
         for _ in 0..5_000 {
@@ -588,10 +623,31 @@ mod tests {
                 }
             }
             let bits = p.culls_rel8(&lo, &hi, Avx2::detect());
+            assert_eq!(p.culls_rel8(&lo, &hi, None), bits);
             for c in 0..8 {
-                let one = p.culls_rel(Vec3::new(lo[0][c], lo[1][c], lo[2][c]), Vec3::new(hi[0][c], hi[1][c], hi[2][c]));
+                let (l, h) = (Vec3::new(lo[0][c], lo[1][c], lo[2][c]), Vec3::new(hi[0][c], hi[1][c], hi[2][c]));
+                let one = p.culls_rel(l, h);
                 assert_eq!(bits >> c & 1 == 1, one, "box {c}");
                 culled += usize::from(one);
+                // A culled box meets no segment from the apex to a point of the light (a slab
+                // test in f64).
+                for _ in 0..one as usize * 16 {
+                    let y = light.sample(glam::Vec2::new(rng.next_f32(), rng.next_f32())) - apex;
+                    let (mut t0, mut t1) = (0f64, 1f64);
+                    for k in 0..3 {
+                        let (o, d) = (0f64, f64::from(y[k]));
+                        let (a, b) = (f64::from(l[k]) - o, f64::from(h[k]) - o);
+                        if d == 0.0 {
+                            if a > 0.0 || b < 0.0 {
+                                t1 = -1.0;
+                            }
+                        } else {
+                            let (u, v) = (a / d, b / d);
+                            (t0, t1) = (t0.max(u.min(v)), t1.min(u.max(v)));
+                        }
+                    }
+                    assert!(t0 > t1, "box {l} {h} meets the segment to {y}");
+                }
             }
         }
         assert!(culled > 1000 && culled < 39_000, "{culled}");

@@ -228,6 +228,8 @@ impl Fan {
         #[cfg(not(target_arch = "x86_64"))]
         let _ = simd;
         self.inverse_ready = true;
+        // A fan of many rays: boxes outside the pyramid's bounding box are culled too.
+        self.pyramid.bound();
     }
 
     /// Computes the shears of the current rays if [`Fan::set`] left them (before a watertight
