@@ -297,7 +297,8 @@ impl Pyramid {
     /// `-|d|`. Each edge function is linear in `d`, so where every corner `c` gives
     /// `s_i . c > 1.1 (|c| + r (1 + |s_i|))` (and another edge the same below), so does every
     /// direction in the corners' cone, and a sample's direction strays from that cone by at most
-    /// `r` (the field `reach`); the factor 1.1 covers the rounding of `s_i . c` (at most
+    /// `r` (computed on first use with the corners' lengths, the field `cone`); the factor 1.1
+    /// covers the rounding of `s_i . c` (at most
     /// `3 ε |s_i| |c|`, and `|s_i| <= 1 / (256 ε)`). False for lights of more than four corners.
     #[inline(always)]
     pub(crate) fn outside_cone(&mut self, s: &[Vec3; 3]) -> bool {

@@ -142,12 +142,12 @@ impl Fan {
         let _ = simd;
         #[cfg(target_arch = "x86_64")]
         if simd.is_some() {
-            // SAFETY: AVX2 is available (the proof).
             // A fan of at most `DIRECT_MAX` rays gives every triangle it meets to the watertight
             // test, so it needs its shears anyway: all at once costs less (measured,
             // docs/results.md issue 21 session 29); a larger one leaves the inverse directions
             // and the shears to first use.
             let (all, kz, s, k) = (&mut self.all, &mut self.all_kz, &mut self.shear_s, &mut self.shear_k);
+            // SAFETY: AVX2 is available (the proof).
             done = unsafe {
                 if n <= DIRECT_MAX as usize {
                     fan_lanes_avx::<true>(rays.targets, x, all, kz, s, k)
@@ -430,6 +430,7 @@ impl Fan {
         ctx: &mut QueryCtx,
         simd: Option<Avx2>,
     ) -> u8 {
+        debug_assert!(self.inverse_ready);
         let [.., ix, iy, iz] = &self.all;
         ctx.stats.box_tests += u64::from(alive.count_ones());
         ray_meets_boxes(lo, hi, alive, &BoxLanes { ix, iy, iz }, k, simd)
