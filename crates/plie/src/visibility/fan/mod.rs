@@ -518,6 +518,11 @@ impl Fan {
                 return;
             }
             let s = edge_normals(a, b, c);
+            let finite = s.iter().all(|v| v.is_finite());
+            // Every sample outside the triangle's cone: all sure misses at once.
+            if finite && self.pyramid.outside_cone(&s) {
+                return;
+            }
             // The watertight test's hit parameter is a weighted mean of the vertices' `p[kz] / d[kz]`
             // (computed as it computes them); lanes where all of them lie outside the segment's range
             // (beyond a margin for the mean's rounding) miss. Per axis, the least and greatest vertex
@@ -528,11 +533,7 @@ impl Fan {
             for w in 0..words {
                 self.maybe[w] = self.open[w] & mask(w);
             }
-            if s.iter().all(|v| v.is_finite()) {
-                // Every sample outside the triangle's cone: all sure misses at once.
-                if self.pyramid.outside_cone(&s) {
-                    return;
-                }
+            if finite {
                 let [x, y, z, len, sz, ..] = &self.all;
                 let lanes = Lanes { x, y, z, len, sz, kz: &self.all_kz };
                 misses(&s, &span, &lanes, &mut self.maybe[..words], simd);
@@ -699,7 +700,7 @@ mod tests {
         let (mut outside, mut inside) = (0, 0);
         // Near the origin a tilted light; far from it an axis-aligned one (whose corners stay
         // coplanar in `f32`). Each as a parallelogram sampled over a fourth corner moved outward
-        // by almost what the light's check accepts, and as a triangle.
+        // by about half of what the light's check accepts, and as a triangle.
         let tilted = (Vec3::new(0.31, 0.02, 0.97), Vec3::new(0.93, -0.01, -0.29));
         let level = (Vec3::new(0.0, 0.0, 0.97), Vec3::new(0.93, 0.0, 0.0));
         let places = [(Vec3::ZERO, tilted), (Vec3::new(400.0, -300.0, 600.0), level)];
@@ -735,7 +736,7 @@ mod tests {
                         1 => a = samples[4 + j],
                         // A vertex on (or a rounding beside) the segment to a sample, so that two
                         // edge planes graze it.
-                        2 => a = x + (samples[j % 4 + 4 * (j / 4)] - x) * 0.5 + (a - x) * (j as f32 * 1e-7),
+                        2 => a = x + (samples[j] - x) * 0.5 + (a - x) * (j as f32 * 1e-7),
                         _ => {}
                     }
                     let s = edge_normals(a - x, b - x, c - x);
