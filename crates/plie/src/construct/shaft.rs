@@ -68,8 +68,11 @@ impl Shaft {
     /// normal has three non-zero components would meet each box in one corner only, so every facet
     /// is a face of the boxes' bounds or parallel to an axis. Those parallel to axis `e` are the
     /// lines of the hull of the two rectangles the boxes project to along `e`: through a corner of
-    /// each, with all eight corners on one side. So this is [`Shaft::of_points`] of the sixteen
-    /// corners, from 3 x 16 candidate lines instead of 560 triples.
+    /// each, with all eight corners on one side. Such a line that is not along an axis has an
+    /// outward normal with two non-zero components, and each rectangle's one corner farthest along
+    /// it is of the same kind (least or greatest in each coordinate, by the normal's signs): so it
+    /// passes through the two rectangles' corners of one kind. So this is [`Shaft::of_points`] of
+    /// the sixteen corners, from 3 x 4 candidate lines instead of 560 triples.
     pub fn of_boxes(a: &Aabb, b: &Aabb, tol: f32) -> Shaft {
         let bounds = a.union(*b).expanded(tol);
         let mut planes: Vec<Plane> = Vec::with_capacity(12);
@@ -81,33 +84,32 @@ impl Shaft {
             };
             let (ra, rb) = (rect(a), rect(b));
             let all = [ra[0], ra[1], ra[2], ra[3], rb[0], rb[1], rb[2], rb[3]];
-            for p in ra {
-                for q in rb {
-                    let (du, dv) = (q[0] - p[0], q[1] - p[1]);
-                    // A line along an axis (or no line) is a face of the bounds, planes already.
-                    if du == 0.0 || dv == 0.0 {
-                        continue;
-                    }
-                    // Which side of the line through `p` and `q` each corner lies on: all on one.
-                    let (mut below, mut above) = (false, false);
-                    for x in all {
-                        let s = dv * (x[0] - p[0]) - du * (x[1] - p[1]);
-                        below |= s < 0.0;
-                        above |= s > 0.0;
-                    }
-                    if below && above {
-                        continue;
-                    }
-                    let sign = if above { -1.0 } else { 1.0 };
-                    let mut n = DVec3::ZERO;
-                    (n[u], n[v]) = (sign * dv, -sign * du);
-                    let n = n / n.length();
-                    // Through `p` (and `q`): every corner inside, but for rounding far below `tol`.
-                    let plane = Plane { n, d: n[u] * p[0] + n[v] * p[1] };
-                    // Corners that project to one point give the same line more than once.
-                    if !planes.contains(&plane) {
-                        planes.push(plane);
-                    }
+            // Corners of one kind.
+            for (p, q) in ra.into_iter().zip(rb) {
+                let (du, dv) = (q[0] - p[0], q[1] - p[1]);
+                // A line along an axis (or no line) is a face of the bounds, planes already.
+                if du == 0.0 || dv == 0.0 {
+                    continue;
+                }
+                // Which side of the line through `p` and `q` each corner lies on: all on one.
+                let (mut below, mut above) = (false, false);
+                for x in all {
+                    let s = dv * (x[0] - p[0]) - du * (x[1] - p[1]);
+                    below |= s < 0.0;
+                    above |= s > 0.0;
+                }
+                if below && above {
+                    continue;
+                }
+                let sign = if above { -1.0 } else { 1.0 };
+                let mut n = DVec3::ZERO;
+                (n[u], n[v]) = (sign * dv, -sign * du);
+                let n = n / n.length();
+                // Through `p` (and `q`): every corner inside, but for rounding far below `tol`.
+                let plane = Plane { n, d: n[u] * p[0] + n[v] * p[1] };
+                // Corners that project to one point give the same line more than once.
+                if !planes.contains(&plane) {
+                    planes.push(plane);
                 }
             }
         }
