@@ -100,7 +100,7 @@ impl LocalPlane {
 /// The slanted planes of a cut's region ([`LocalPlane`]) in `f32`, so that eight boxes are tested
 /// at once ([`LanePlanes::keep8`]).
 #[derive(Clone, Copy, Debug, Default)]
-pub(super) struct LanePlanes {
+struct LanePlanes {
     /// Per plane: `n`, `|n|` (per axis), `2 k`, and the rounding bound's `16 ε |n|_1` and
     /// `32 ε |k|`.
     n: [[f32; 3]; SLANTED_MAX],
