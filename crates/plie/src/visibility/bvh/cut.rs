@@ -283,16 +283,14 @@ impl Bvh {
     fn children_in(&self, n: u32, planes: &LanePlanes, (lo, hi): (Vec3, Vec3), to: &mut [Entry; 8]) -> usize {
         let node = &self.cw.nodes[n as usize];
         let (los, his) = child_lanes(node);
-        let mut inside = [1u32; 8];
+        // Filled slots whose boxes meet the region's box.
+        let mut inside = node.child_meta.map(|m| u32::from(m != 0));
         for k in 0..3 {
             for c in 0..8 {
                 inside[c] &= u32::from(los[k][c] <= hi[k]) & u32::from(his[k][c] >= lo[k]);
             }
         }
-        let mut meets = planes.keep8(&los, &his);
-        for (c, &i) in inside.iter().enumerate() {
-            meets &= !(u8::from(i == 0 || node.child_meta[c] == 0) << c);
-        }
+        let mut meets = planes.keep8(&los, &his) & (0..8).fold(0, |bits, c| bits | (inside[c] as u8) << c);
         let mut len = 0;
         while meets != 0 {
             let c = meets.trailing_zeros() as usize;
