@@ -355,6 +355,58 @@ impl Pyramid {
         n.dot(tri.v[0]) - off < -m && n.dot(tri.v[1]) - off < -m && n.dot(tri.v[2]) - off < -m
     }
 
+    /// Of up to eight triangles in lanes, those [`Pyramid::culls`] culls, as bits (bit `c` for lane
+    /// `c`; lanes past the block's triangles come out as its zero triangles do). With `simd` and
+    /// at most four sides, eight lanes at a time: the same operations in the same order, so the
+    /// same bits.
+    #[inline]
+    pub(crate) fn culls8(&self, t: &TriLanes, simd: Option<Avx2>) -> u8 {
+        #[cfg(not(target_arch = "x86_64"))]
+        let _ = simd;
+        #[cfg(target_arch = "x86_64")]
+        if let (Some(_), Some(lanes)) = (simd, &self.lanes) {
+            // SAFETY: AVX2 is available (the proof).
+            return unsafe { self.culls8_avx(lanes, t) };
+        }
+        (0..8).fold(0, |bits, c| bits | u8::from(self.culls(&t.triangle(c))) << c)
+    }
+
+    /// [`Pyramid::culls8`] in AVX lanes, for at most four sides (`lanes`: [`Pyramid::lanes`]).
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx,avx2")]
+    unsafe fn culls8_avx(&self, [sx, sy, sz]: &[Vec4; 3], t: &TriLanes) -> u8 {
+        use std::arch::x86_64::*;
+        let load = |v: &[f32; 8]| {
+            // SAFETY: eight floats.
+            unsafe { _mm256_loadu_ps(v.as_ptr()) }
+        };
+        let (sp, mul, add) = (|v: f32| _mm256_set1_ps(v), |a, b| _mm256_mul_ps(a, b), |a, b| _mm256_add_ps(a, b));
+        let x = self.apex;
+        let m = sp(-self.margin);
+        // Each vertex, absolute (for the cap) and relative to the apex (for the sides).
+        let abs = t.v.map(|v| v.map(|a| load(&a)));
+        let rel = abs
+            .map(|[vx, vy, vz]| [_mm256_sub_ps(vx, sp(x.x)), _mm256_sub_ps(vy, sp(x.y)), _mm256_sub_ps(vz, sp(x.z))]);
+        let mut culled = _mm256_setzero_ps();
+        // The four lanes of the sides (a triangle's third side repeated: the same test twice).
+        for i in 0..4 {
+            let (a, b, c) = (sp(sx[i]), sp(sy[i]), sp(sz[i]));
+            let beyond = |[px, py, pz]: [__m256; 3]| {
+                _mm256_cmp_ps::<_CMP_LT_OQ>(add(add(mul(a, px), mul(b, py)), mul(c, pz)), m)
+            };
+            let all = _mm256_and_ps(_mm256_and_ps(beyond(rel[0]), beyond(rel[1])), beyond(rel[2]));
+            culled = _mm256_or_ps(culled, all);
+        }
+        // The cap (the pyramid has sides: `lanes` holds them).
+        let (n, off) = self.cap;
+        let (nx, ny, nz, off) = (sp(n.x), sp(n.y), sp(n.z), sp(off));
+        let below = |[px, py, pz]: [__m256; 3]| {
+            _mm256_cmp_ps::<_CMP_LT_OQ>(_mm256_sub_ps(add(add(mul(nx, px), mul(ny, py)), mul(nz, pz)), off), m)
+        };
+        let all = _mm256_and_ps(_mm256_and_ps(below(abs[0]), below(abs[1])), below(abs[2]));
+        _mm256_movemask_ps(_mm256_or_ps(culled, all)) as u8
+    }
+
     /// True if no segment of the pyramid can meet anything in the box `[lo, hi]`, given relative to
     /// the apex. Only the side planes (and, where [`Pyramid::bound`] computed it, the bounding box)
     /// are tested. (The walks use [`Pyramid::culls_rel8`]; this is its reference.)
@@ -455,6 +507,34 @@ impl Pyramid {
         }
         let (n, off) = self.cap;
         n.dot(far(n)) - off < -m
+    }
+}
+
+/// Up to eight triangles in lanes, for [`Pyramid::culls8`]: `v[k][axis][lane]` is coordinate
+/// `axis` of vertex `k` of the block's triangle `lane` (zero past the last).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub(crate) struct TriLanes {
+    v: [[[f32; 8]; 3]; 3],
+}
+
+impl TriLanes {
+    /// The block of `tris` (at most eight).
+    pub(crate) fn of<'t>(tris: impl IntoIterator<Item = &'t Triangle>) -> TriLanes {
+        let mut t = TriLanes::default();
+        for (c, tri) in tris.into_iter().take(8).enumerate() {
+            for (k, v) in tri.v.iter().enumerate() {
+                for axis in 0..3 {
+                    t.v[k][axis][c] = v[axis];
+                }
+            }
+        }
+        t
+    }
+
+    /// Lane `c`'s triangle.
+    fn triangle(&self, c: usize) -> Triangle {
+        let v = |k: usize| Vec3::new(self.v[k][0][c], self.v[k][1][c], self.v[k][2][c]);
+        Triangle::new(v(0), v(1), v(2))
     }
 }
 
@@ -652,6 +732,69 @@ mod tests {
             }
         }
         assert!(culled > 1000 && culled < 39_000, "{culled}");
+    }
+
+    /// Eight triangles culled in lanes are those culled one at a time, with and without AVX2:
+    /// over a triangle, a quadrilateral and a hexagon (no lanes) as lights, apexes above and
+    /// beside them and one on the light's plane (an empty pyramid), and triangles whose vertices
+    /// lie a hair inside or outside a side or the cap, or far away; blocks of one to eight.
+    #[test]
+    fn eight_triangle_cull_equals_one_at_a_time() {
+        let square = vec![
+            Vec3::new(0.0, 2.0, 0.0),
+            Vec3::new(1.0, 2.0, 0.0),
+            Vec3::new(1.0, 2.0, 1.0),
+            Vec3::new(0.0, 2.0, 1.0),
+        ];
+        let triangle = square[..3].to_vec();
+        let hexagon: Vec<Vec3> = (0..6)
+            .map(|i| {
+                let a = std::f32::consts::TAU * i as f32 / 6.0;
+                Vec3::new(0.5 + 0.5 * a.cos(), 2.0, 0.5 + 0.5 * a.sin())
+            })
+            .collect();
+        let mut rng = Rng::stream(9, 0, 0, 0);
+        let (mut culled, mut kept) = (0, 0);
+        for vertices in [square, triangle, hexagon] {
+            let light = Light::new(vertices, Vec3::ONE, vec![]).unwrap();
+            for apex in [Vec3::new(0.3, 0.0, 0.4), Vec3::new(-1.5, 0.5, 2.0), Vec3::new(0.5, 2.0, 3.0)] {
+                let mut p = Pyramid::default();
+                let ok = p.set(apex, &light, 1e-4);
+                assert_eq!(ok, apex.y < 1.9);
+                for round in 0..400 {
+                    let n = 1 + round % 8;
+                    let tris: Vec<Triangle> = (0..n)
+                        .map(|_| {
+                            // Near the light's corners and the apex (a hair either side of the
+                            // planes), or anywhere in a box around them.
+                            let near = |rng: &mut Rng| {
+                                let base = if rng.next_f32() < 0.5 { light.vertices[0] } else { apex };
+                                let e = 1e-4 * (rng.next_f32() * 4.0 - 2.0);
+                                base + Vec3::new(e, -e, e) * (1.0 + rng.next_f32())
+                            };
+                            let far = |rng: &mut Rng| {
+                                Vec3::new(
+                                    rng.next_f32() * 6.0 - 3.0,
+                                    rng.next_f32() * 6.0 - 2.0,
+                                    rng.next_f32() * 6.0 - 3.0,
+                                )
+                            };
+                            let mut v = || if rng.next_f32() < 0.3 { near(&mut rng) } else { far(&mut rng) };
+                            Triangle::new(v(), v(), v())
+                        })
+                        .collect();
+                    let lanes = TriLanes::of(&tris);
+                    let bits = p.culls8(&lanes, Avx2::detect());
+                    assert_eq!(p.culls8(&lanes, None), bits);
+                    for (c, tri) in tris.iter().enumerate() {
+                        let one = p.culls(tri);
+                        assert_eq!(bits >> c & 1 == 1, one, "triangle {c} of {n}: {tri:?}");
+                        (culled, kept) = (culled + usize::from(one), kept + usize::from(!one));
+                    }
+                }
+            }
+        }
+        assert!(culled > 1000 && kept > 1000, "{culled} culled, {kept} kept");
     }
 
     /// The planes of a triangle or quadrilateral computed in lanes are the edge-by-edge loop's, bit

@@ -24,7 +24,12 @@
 //! Lists are built on a piece's [`BUILD_AT`]-th query (a piece asked a few times would not repay
 //! the walk that gathers it) and shared by all threads, in shards behind locks. At most
 //! [`SHAFT_MAX`] triangles are kept; a piece with more is marked for the walk. The table stops
-//! growing at [`PIECES_MAX`] pieces. Which thread builds a list, and when, changes no answer.
+//! growing at [`PIECES_MAX`] pieces, and no list is built past [`LISTS_MAX`]. Which thread builds
+//! a list, and when, changes no answer.
+//!
+//! A list keeps its triangles' vertices in lanes, eight triangles a block, so that the pyramid of
+//! each query culls them eight at a time ([`Pyramid::culls8`]) instead of reading each triangle
+//! from the scene and testing it alone.
 
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Mutex;
@@ -39,6 +44,8 @@ use crate::geometry::Aabb;
 use crate::octree::LeafId;
 use crate::scene::{LightId, TriId};
 use crate::visibility::fan::Pyramid;
+use crate::visibility::pyramid::TriLanes;
+use crate::visibility::simd::Avx2;
 use crate::visibility::{LightRays, QueryCtx};
 
 /// Most triangles a piece's list keeps: a light with more from that piece walks the scene BVH.
@@ -60,10 +67,13 @@ const BUILD_AT: u32 = 32;
 /// ten, [`crate::visibility::pyramid::margin_of`]).
 const SHAFT_MARGIN: f32 = 16.0;
 
-/// Most pieces the table holds: about 32 bytes each in the table, and about 112 more for those
-/// with a list (at most [`SHAFT_MAX`] triangles), so at most about 150 MiB, which only a render of
-/// over 30 million (point, light) pairs in uncrowded leaves reaches.
+/// Most pieces the table holds: about 32 bytes each, so at most about 32 MiB, which only a render
+/// of over 30 million (point, light) pairs in uncrowded leaves reaches.
 const PIECES_MAX: usize = 1 << 20;
+
+/// Most lists built: about 700 bytes each at most (the list of at most [`SHAFT_MAX`] triangles and
+/// two blocks of their vertices in lanes, 288 bytes a block), so at most about 90 MiB.
+const LISTS_MAX: usize = 1 << 17;
 
 /// Shards of the table: locks taken by different threads rarely meet.
 const SHARDS: usize = 64;
@@ -82,14 +92,16 @@ enum Piece {
     List(u32),
 }
 
-/// A piece's list: `tris[start..start + len]` of its shard, for the points within `within` (the
-/// piece's box, grown by the tolerance) and with `plane.0 . x <= plane.1`.
+/// A piece's list: `tris[start..start + len]` of its shard, their vertices in blocks of eight
+/// from `lanes[block]` on, for the points within `within` (the piece's box, grown by the
+/// tolerance) and with `plane.0 . x <= plane.1`.
 #[derive(Clone, Copy, Debug)]
 struct List {
     within: Aabb,
     plane: (DVec3, f64),
     start: u32,
     len: u32,
+    block: u32,
 }
 
 /// A shard of the table.
@@ -98,17 +110,20 @@ struct Shard {
     pieces: FxHashMap<Key, Piece>,
     lists: Vec<List>,
     tris: Vec<TriId>,
+    lanes: Vec<TriLanes>,
 }
 
 /// The table of pieces and their lists, shared by the threads of a render.
 pub(crate) struct Shafts {
     shards: Vec<Mutex<Shard>>,
     pieces: AtomicUsize,
+    lists: AtomicUsize,
 }
 
 impl Default for Shafts {
     fn default() -> Shafts {
-        Shafts { shards: (0..SHARDS).map(|_| Mutex::default()).collect(), pieces: AtomicUsize::new(0) }
+        let shards = (0..SHARDS).map(|_| Mutex::default()).collect();
+        Shafts { shards, pieces: AtomicUsize::new(0), lists: AtomicUsize::new(0) }
     }
 }
 
@@ -141,7 +156,7 @@ impl LieVisibility<'_> {
             &self.shafts.shards[(leaf.0 as usize ^ (tri.0 as usize).wrapping_mul(31) ^ rays.light.idx()) % SHARDS];
         {
             let mut s = shard.lock().unwrap_or_else(|e| e.into_inner());
-            let Shard { pieces, lists, tris } = &mut *s;
+            let Shard { pieces, lists, tris, lanes } = &mut *s;
             match pieces.get_mut(&key) {
                 None => {
                     if self.shafts.pieces.fetch_add(1, Ordering::Relaxed) < PIECES_MAX {
@@ -155,13 +170,18 @@ impl LieVisibility<'_> {
                     if *n < BUILD_AT {
                         return Found::Walk;
                     }
+                    if self.shafts.lists.load(Ordering::Relaxed) >= LISTS_MAX {
+                        pieces.insert(key, Piece::Walk);
+                        return Found::Walk;
+                    }
                 }
                 Some(&mut Piece::List(i)) => {
-                    let List { within, plane, start, len } = lists[i as usize];
+                    let List { within, plane, start, len, block } = lists[i as usize];
                     if !accepts(&within, plane, rays.origin) {
                         return Found::Walk;
                     }
-                    self.uncut(&tris[start as usize..(start + len) as usize], pyramid, out, ctx);
+                    let list = &tris[start as usize..(start + len) as usize];
+                    uncut(list, &lanes[block as usize..], pyramid, out, ctx);
                     return Found::List;
                 }
             }
@@ -169,33 +189,30 @@ impl LieVisibility<'_> {
         // Built outside the lock (two threads may build the same piece: the same list).
         let built = self.build_piece(leaf, tri, rays.light, out);
         let mut s = shard.lock().unwrap_or_else(|e| e.into_inner());
-        let list =
-            built.map(|(within, plane)| List { within, plane, start: s.tris.len() as u32, len: out.len() as u32 });
+        let (start, block) = (s.tris.len() as u32, s.lanes.len() as u32);
+        let list = built.map(|(within, plane)| List { within, plane, start, len: out.len() as u32, block });
         match list {
             None => {
                 s.pieces.insert(key, Piece::Walk);
                 Found::Walk
             }
             Some(list) => {
+                self.shafts.lists.fetch_add(1, Ordering::Relaxed);
                 s.tris.extend_from_slice(out);
+                let triangles = &self.scene.triangles;
+                s.lanes.extend(out.chunks(8).map(|c| TriLanes::of(c.iter().map(|t| &triangles[t.idx()]))));
                 let i = s.lists.len() as u32;
                 s.lists.push(list);
                 s.pieces.insert(key, Piece::List(i));
                 if accepts(&list.within, list.plane, rays.origin) {
-                    self.uncut(&s.tris[list.start as usize..], pyramid, out, ctx);
+                    let Shard { tris, lanes, .. } = &*s;
+                    uncut(&tris[start as usize..], &lanes[block as usize..], pyramid, out, ctx);
                     Found::List
                 } else {
                     Found::Walk
                 }
             }
         }
-    }
-
-    /// The triangles of a piece's list `list` that `pyramid` does not cull, into `out`.
-    fn uncut(&self, list: &[TriId], pyramid: &Pyramid, out: &mut Vec<TriId>, ctx: &mut QueryCtx) {
-        ctx.stats.box_tests += list.len() as u64;
-        out.clear();
-        out.extend(list.iter().filter(|t| !pyramid.culls(&self.scene.triangles[t.idx()])));
     }
 
     /// The triangles (into `out`) that meet the shaft of the piece of `tri` in `leaf` toward
@@ -254,6 +271,22 @@ impl LieVisibility<'_> {
             out.len() <= SHAFT_MAX
         });
         complete.then_some((within, plane))
+    }
+}
+
+/// The triangles of a piece's list `list` (their vertices in `lanes`, a block of eight after
+/// another) that `pyramid` does not cull, into `out`, in order.
+fn uncut(list: &[TriId], lanes: &[TriLanes], pyramid: &Pyramid, out: &mut Vec<TriId>, ctx: &mut QueryCtx) {
+    ctx.stats.box_tests += list.len() as u64;
+    out.clear();
+    let simd = Avx2::detect();
+    for (tris, block) in list.chunks(8).zip(lanes) {
+        let mut keep = !pyramid.culls8(block, simd) & ((1u16 << tris.len()) - 1) as u8;
+        while keep != 0 {
+            let c = keep.trailing_zeros() as usize;
+            keep &= keep - 1;
+            out.push(tris[c]);
+        }
     }
 }
 
