@@ -125,14 +125,20 @@ impl Bvh {
         let to_world = 1.0 / self.scale;
         walk.nodes.clear();
         walk.masks.clear();
+        walk.pending.clear();
         walk.child_masks.resize(8 * w, 0);
         // The order of inner children: nearest first along the first sample's direction.
         let toward = rays.targets[0] - fan.origin();
-        let WalkStack { nodes, masks, node_mask, child_masks, ray_nodes, ray_mask } = walk;
+        let WalkStack { nodes, masks, pending, node_mask, child_masks, ray_nodes, ray_mask } = walk;
+        let stack = (&mut *nodes, &mut *masks, &mut *pending);
         match cut {
             None => {
-                nodes.push(0);
-                masks.extend_from_slice(fan.open());
+                if ONE {
+                    pending.push((fan.open()[0], 0));
+                } else {
+                    nodes.push(0);
+                    masks.extend_from_slice(fan.open());
+                }
             }
             Some(cut) => {
                 // The cut's entries as the children of one node, their boxes made relative to the
@@ -152,19 +158,23 @@ impl Bvh {
                 let hit =
                     fan.meets8(&los, &his, filled & !culled, &node_mask[..w], &mut child_masks[..8 * w], ctx, simd);
                 let at = (hit, &los, &his, |c: usize| cut.child[c]);
-                if self.take_children::<P, ONE>(prims, rays, fan, out, ctx, at, toward, nodes, masks, child_masks, simd)
-                {
+                if self.take_children::<P, ONE>(prims, rays, fan, out, ctx, at, toward, stack, child_masks, simd) {
                     return;
                 }
             }
         }
-        while let Some(ni) = nodes.pop() {
-            // One word of mask (up to 64 rays) is kept in a register, more in the scratch.
+        loop {
+            // One word of mask (up to 64 rays) is kept in a register, with its node, more in the
+            // scratch.
             let mut word = [0u64; 1];
+            let ni;
             let node_mask: &[u64] = if ONE {
-                word[0] = masks.pop().unwrap_or(0);
+                let Some((m, n)) = pending.pop() else { break };
+                (word[0], ni) = (m, n);
                 &word
             } else {
+                let Some(n) = nodes.pop() else { break };
+                ni = n;
                 let at = masks.len() - w;
                 // Word by word: masks are one or two words, too short for a copy call.
                 node_mask.clear();
@@ -195,7 +205,8 @@ impl Bvh {
             let filled = nonzero_bytes(u64::from_le_bytes(node.child_meta));
             let hit = fan.meets8(&los, &his, filled & !culled, &node_mask[..w], &mut child_masks[..8 * w], ctx, simd);
             let at = (hit, &los, &his, |c: usize| Child::of(node, c));
-            if self.take_children::<P, ONE>(prims, rays, fan, out, ctx, at, toward, nodes, masks, child_masks, simd) {
+            let stack = (&mut *nodes, &mut *masks, &mut *pending);
+            if self.take_children::<P, ONE>(prims, rays, fan, out, ctx, at, toward, stack, child_masks, simd) {
                 return;
             }
         }
@@ -287,8 +298,7 @@ impl Bvh {
         ctx: &mut QueryCtx,
         (hit, los, his, child_of): (u8, &[[f32; 8]; 3], &[[f32; 8]; 3], impl Fn(usize) -> Child),
         toward: Vec3,
-        nodes: &mut Vec<u32>,
-        masks: &mut Vec<u64>,
+        (nodes, masks, stack): (&mut Vec<u32>, &mut Vec<u64>, &mut Vec<(u64, u32)>),
         child_masks: &[u64],
         simd: Option<Avx2>,
     ) -> bool {
@@ -330,9 +340,13 @@ impl Bvh {
                 }
             }
             for &(_, n, slot) in &pending[..count] {
-                nodes.push(n);
-                for &m in &child_masks[slot * w..(slot + 1) * w] {
-                    masks.push(m);
+                if ONE {
+                    stack.push((child_masks[slot], n));
+                } else {
+                    nodes.push(n);
+                    for &m in &child_masks[slot * w..(slot + 1) * w] {
+                        masks.push(m);
+                    }
                 }
             }
         }
