@@ -125,16 +125,15 @@ impl Bvh {
         let to_world = 1.0 / self.scale;
         walk.nodes.clear();
         walk.masks.clear();
-        walk.pending.clear();
+        walk.visits.clear();
         walk.child_masks.resize(8 * w, 0);
         // The order of inner children: nearest first along the first sample's direction.
         let toward = rays.targets[0] - fan.origin();
-        let WalkStack { nodes, masks, pending, node_mask, child_masks, ray_nodes, ray_mask } = walk;
-        let stack = (&mut *nodes, &mut *masks, &mut *pending);
+        let WalkStack { nodes, masks, visits, node_mask, child_masks, ray_nodes, ray_mask } = walk;
         match cut {
             None => {
                 if ONE {
-                    pending.push((fan.open()[0], 0));
+                    visits.push((fan.open()[0], 0));
                 } else {
                     nodes.push(0);
                     masks.extend_from_slice(fan.open());
@@ -158,6 +157,7 @@ impl Bvh {
                 let hit =
                     fan.meets8(&los, &his, filled & !culled, &node_mask[..w], &mut child_masks[..8 * w], ctx, simd);
                 let at = (hit, &los, &his, |c: usize| cut.child[c]);
+                let stack = (&mut *nodes, &mut *masks, &mut *visits);
                 if self.take_children::<P, ONE>(prims, rays, fan, out, ctx, at, toward, stack, child_masks, simd) {
                     return;
                 }
@@ -169,7 +169,7 @@ impl Bvh {
             let mut word = [0u64; 1];
             let ni;
             let node_mask: &[u64] = if ONE {
-                let Some((m, n)) = pending.pop() else { break };
+                let Some((m, n)) = visits.pop() else { break };
                 (word[0], ni) = (m, n);
                 &word
             } else {
@@ -205,7 +205,7 @@ impl Bvh {
             let filled = nonzero_bytes(u64::from_le_bytes(node.child_meta));
             let hit = fan.meets8(&los, &his, filled & !culled, &node_mask[..w], &mut child_masks[..8 * w], ctx, simd);
             let at = (hit, &los, &his, |c: usize| Child::of(node, c));
-            let stack = (&mut *nodes, &mut *masks, &mut *pending);
+            let stack = (&mut *nodes, &mut *masks, &mut *visits);
             if self.take_children::<P, ONE>(prims, rays, fan, out, ctx, at, toward, stack, child_masks, simd) {
                 return;
             }
@@ -286,7 +286,9 @@ impl Bvh {
 
     /// The children `hit` of a visit (child `c` leading to `child_of(c)`, its box `los`/`his`
     /// relative to the apex, its rays in `child_masks`): a leaf's triangles are tested against its
-    /// rays, inner nodes pushed nearest first. True once every ray is closed.
+    /// rays, inner nodes pushed nearest last, so that the nearest is visited first (with their masks
+    /// on `visits` for a fan of one word, else on `nodes` and `masks`). True once every ray is
+    /// closed.
     #[allow(clippy::too_many_arguments)]
     #[inline(always)]
     fn take_children<P: Prims, const ONE: bool>(
@@ -298,7 +300,7 @@ impl Bvh {
         ctx: &mut QueryCtx,
         (hit, los, his, child_of): (u8, &[[f32; 8]; 3], &[[f32; 8]; 3], impl Fn(usize) -> Child),
         toward: Vec3,
-        (nodes, masks, stack): (&mut Vec<u32>, &mut Vec<u64>, &mut Vec<(u64, u32)>),
+        (nodes, masks, visits): (&mut Vec<u32>, &mut Vec<u64>, &mut Vec<(u64, u32)>),
         child_masks: &[u64],
         simd: Option<Avx2>,
     ) -> bool {
@@ -341,7 +343,7 @@ impl Bvh {
             }
             for &(_, n, slot) in &pending[..count] {
                 if ONE {
-                    stack.push((child_masks[slot], n));
+                    visits.push((child_masks[slot], n));
                 } else {
                     nodes.push(n);
                     for &m in &child_masks[slot * w..(slot + 1) * w] {

@@ -667,14 +667,14 @@ impl LightScratch {
 
 /// Scratch of a fan's walk down a tree (the scene BVH's, `Bvh::fan_occluded`): the nodes still to
 /// visit, each with its mask of rays (one after the other in `masks`; for a fan of at most 64
-/// rays, each mask with its node in `pending`, one push and one pop a node), the masks of the node
+/// rays, each mask with its node in `visits`, one push and one pop a node), the masks of the node
 /// being visited and of its eight children, and the nodes and mask of a ray walking a subtree
 /// alone.
 #[derive(Clone, Debug, Default)]
 pub struct WalkStack {
     pub nodes: Vec<u32>,
     pub masks: Vec<u64>,
-    pub pending: Vec<(u64, u32)>,
+    pub visits: Vec<(u64, u32)>,
     pub node_mask: Vec<u64>,
     pub child_masks: Vec<u64>,
     pub ray_nodes: Vec<u32>,
