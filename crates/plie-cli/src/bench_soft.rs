@@ -5,7 +5,9 @@
 //! and 64 shadow rays per light with every mode: `none` (no shadow test: the floor), the exact modes
 //! but `brute` and `octree`, `embree` where built with it, the P-LIE modes on the refined P-LIE
 //! (`grid+u`), and `grid` asked ray by ray (`grid/ray`: the per-ray query as before the per-light
-//! query). Written to `soft-shadows.md` and `soft-shadows.json`.
+//! query). The modes' runs are interleaved (every mode's first run, then every mode's second, ...),
+//! so that a noisy spell of the shared machine falls on all of them alike. Written to
+//! `soft-shadows.md` and `soft-shadows.json`.
 
 use std::path::Path;
 use std::time::Instant;
@@ -92,6 +94,17 @@ fn columns() -> Vec<Column> {
     c
 }
 
+/// A column's visibility at one shadow-ray count, with its timings (wall and CPU seconds per run)
+/// and the counters of its last run.
+struct Timed<'a> {
+    col: Column,
+    vis: Box<dyn Visibility + 'a>,
+    hits: &'a HitBuffer,
+    walls: Vec<f64>,
+    cpus: Vec<f64>,
+    stats: Option<plie::visibility::QueryStats>,
+}
+
 /// A visibility answered ray by ray: the per-light query falls back to the trait's loop.
 struct PerRay<'a>(Box<dyn Visibility + 'a>);
 
@@ -146,6 +159,7 @@ pub fn run(scenes: &[String], out: &Path, runs: usize, quiet: bool) -> Result<()
         let hits = HitBuffer::build(&scene, &camera, (SIZE, SIZE, 1), bvh, Some(env.octree()));
         let r_hits = HitBuffer::build(&scene, &camera, (SIZE, SIZE, 1), bvh, Some(refined.octree()));
         for n in SHADOW_RAYS {
+            let mut cols = Vec::new();
             for col in columns() {
                 let (vis, hits): (Box<dyn Visibility + '_>, _) = match col {
                     Column::Mode(m) if !m.needs_plie() => (shadows.visibility(m)?, &hits),
@@ -153,17 +167,22 @@ pub fn run(scenes: &[String], out: &Path, runs: usize, quiet: bool) -> Result<()
                     Column::Refined(m) => (refined.visibility(m, &scene)?, &r_hits),
                     Column::PerRay(m) => (Box::new(PerRay(env.visibility(m, &scene)?)), &hits),
                 };
-                let (mut walls, mut cpus) = (Vec::new(), Vec::new());
-                let mut last = None;
-                for _ in 0..runs {
-                    let (t, c) = (Instant::now(), process_cpu_seconds());
-                    last = Some(shade(&scene, hits, vis.as_ref(), n, 1, &NoProgress).1);
-                    walls.push(t.elapsed().as_secs_f64());
-                    if let Some((a, b)) = c.zip(process_cpu_seconds()) {
-                        cpus.push(b - a);
+                cols.push(Timed { col, vis, hits, walls: Vec::new(), cpus: Vec::new(), stats: None });
+            }
+            // The modes' runs interleaved (every mode's first run, then every mode's second, ...),
+            // so that a noisy spell of the machine falls on all of them alike.
+            for _ in 0..runs {
+                for c in &mut cols {
+                    let (t, cpu) = (Instant::now(), process_cpu_seconds());
+                    c.stats = Some(shade(&scene, c.hits, c.vis.as_ref(), n, 1, &NoProgress).1);
+                    c.walls.push(t.elapsed().as_secs_f64());
+                    if let Some((a, b)) = cpu.zip(process_cpu_seconds()) {
+                        c.cpus.push(b - a);
                     }
                 }
-                let stats = last.expect("one run");
+            }
+            for Timed { col, vis, hits, mut walls, mut cpus, stats } in cols {
+                let stats = stats.expect("one run");
                 let differing = match col {
                     Column::Mode(m) if m != Mode::None && !m.is_exact() => {
                         let bvh_vis = shadows.visibility(Mode::Bvh)?;

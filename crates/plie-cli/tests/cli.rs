@@ -440,6 +440,41 @@ fn bench_quick_writes_report_csv_json_and_chart() {
     assert!(scenes.iter().all(|s| svg.contains(s)), "chart lacks the scene names");
 }
 
+/// The soft-shadow table: every mode at 4, 16 and 64 shadow rays, each once, timed in every run
+/// (the runs of the modes are interleaved), with the floor and the per-ray `grid` among them.
+#[test]
+fn bench_soft_shadows_times_every_mode_at_every_ray_count() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("soft");
+    let args = ["bench", "--soft-shadows", "--scenes", "cornell-cube-1", "--runs", "2", "--quiet", "--out"];
+    let o = plie(&[&args[..], &[out.to_str().unwrap()]].concat());
+    assert!(o.status.success(), "{}", stderr(&o));
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("soft-shadows.json")).unwrap()).expect("JSON");
+    assert_eq!(json["runs"], 2);
+    let rows = json["rows"].as_array().unwrap();
+    let modes = ["none", "bvh", "lie", "umbra", "penumbra", "grid", "grid+u", "grid/ray"];
+    for n in [4, 16, 64] {
+        for m in modes {
+            let found: Vec<_> = rows.iter().filter(|r| r["mode"] == m && r["shadow_rays"] == n).collect();
+            assert_eq!(found.len(), 1, "{m} at {n} rays: {found:?}");
+            let r = found[0];
+            assert_eq!(r["scene"], "cornell-cube-1");
+            assert!(r["seconds"].as_f64().unwrap() > 0.0, "{r}");
+            assert!(r["rays"].as_u64().unwrap() > 0, "{r}");
+        }
+        // The same rays in every mode, and the same occluded ones in every exact mode.
+        let of = |m: &str, k: &str| rows.iter().find(|r| r["mode"] == m && r["shadow_rays"] == n).unwrap()[k].clone();
+        assert!(modes.iter().all(|&m| of(m, "rays") == of("bvh", "rays")));
+        assert!(modes[1..].iter().all(|&m| of(m, "occluded") == of("bvh", "occluded")));
+        assert_eq!(of("none", "occluded"), 0);
+    }
+    let md = std::fs::read_to_string(out.join("soft-shadows.md")).unwrap();
+    for heading in ["## 4 shadow rays per light", "## 16 shadow rays per light", "## 64 shadow rays per light"] {
+        assert!(md.contains(heading), "no '{heading}':\n{md}");
+    }
+}
+
 #[test]
 fn build_refines_by_umbra_and_render_uses_the_refined_p_lie() {
     let dir = tempfile::tempdir().unwrap();
