@@ -232,7 +232,7 @@ pub fn report(r: &SoftResults) -> String {
     let _ = writeln!(s, "# Soft shadows: shading seconds at {0}x{0}, 1 eye ray per pixel, seed 1\n", r.size);
     let _ = writeln!(
         s,
-        "Command `{}`, {}, {} threads, median of {} runs, CPU: {}.\n",
+        "Command `{}`, {}, {} threads, median of {} runs (the modes' runs interleaved), CPU: {}.\n",
         r.command,
         r.date,
         r.threads,

@@ -470,6 +470,7 @@ fn bench_soft_shadows_times_every_mode_at_every_ray_count() {
         assert_eq!(of("none", "occluded"), 0);
     }
     let md = std::fs::read_to_string(out.join("soft-shadows.md")).unwrap();
+    assert!(md.contains("median of 2 runs (the modes' runs interleaved)"), "{md}");
     for heading in ["## 4 shadow rays per light", "## 16 shadow rays per light", "## 64 shadow rays per light"] {
         assert!(md.contains(heading), "no '{heading}':\n{md}");
     }
