@@ -440,8 +440,9 @@ fn bench_quick_writes_report_csv_json_and_chart() {
     assert!(scenes.iter().all(|s| svg.contains(s)), "chart lacks the scene names");
 }
 
-/// The soft-shadow table: every mode at 4, 16 and 64 shadow rays, each once, timed in every run
-/// (the runs of the modes are interleaved), with the floor and the per-ray `grid` among them.
+/// The soft-shadow table: every mode (the floor and the per-ray `grid` among them) at 4, 16 and 64
+/// shadow rays, once each, timed, with the same rays in every mode and the same occluded rays in
+/// every exact mode; the report says that the modes' runs were interleaved.
 #[test]
 fn bench_soft_shadows_times_every_mode_at_every_ray_count() {
     let dir = tempfile::tempdir().unwrap();
