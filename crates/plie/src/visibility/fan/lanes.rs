@@ -561,9 +561,23 @@ pub(super) struct Lanes<'a> {
     pub(super) kz: &'a [u32],
 }
 
-/// Relative margin of the hit parameter's rounding: the watertight test's weighted mean of three
-/// products is within a few `ε` of the largest one's magnitude.
-const T_MARGIN: f32 = 1e-5;
+/// The hit parameter's bound near the apex: a triangle whose scaled major-axis coordinates
+/// `z_i = sz (v_i - x)[kz]` (as the watertight test computes them) are all finite and at most this
+/// is missed. The test compares `ts = u z_0 + v z_1 + w z_2` with `SEGMENT_EPS d`, `d = u + v + w`,
+/// for edge functions `u, v, w` of one sign (else it misses; take them non-negative, the other
+/// case is the negation). Rounding is monotone, and takes a value below `2^-150` to zero and any
+/// other to at most twice itself, so `ts <= 2 Z_NEAR (u + v + w) (1 + 2^-23) = SEGMENT_EPS (u + v +
+/// w) (1 + 2^-23) / 4`; `SEGMENT_EPS d` rounds to at least half its value if that is at least
+/// `2^-149`, which is more; and if it is less, every product is below `2^-152`, so `ts <= 0`. A
+/// bound relative to the `z_i` alone would not do: where `u, v, w` are below the normal range, each
+/// product's rounding is absolute, and three products rounding up can outweigh `SEGMENT_EPS d`
+/// (found: `z_i = 0.99 SEGMENT_EPS`, edge functions near `10^-41`, a hit at `t = 1.48e-4`).
+const Z_NEAR: f32 = SEGMENT_EPS / 8.0;
+
+/// The hit parameter's bound beyond the light: a triangle whose `z_i` are all finite and at least
+/// this is missed. Each product `u z_i` is then at least `u`, so it rounds to at least `u`, and `ts`
+/// to at least `d`, which is at least `(1 - SEGMENT_EPS) d` rounded (monotone rounding again).
+const Z_FAR: f32 = 1.0;
 
 /// Clears bit `j` of `maybe` (the lanes to decide, set by the caller) where lane `j` is a sure
 /// miss of the triangle with scaled edge normals `s` (see [`Fan::test`]), or its hit parameter
@@ -596,9 +610,10 @@ fn misses_scalar(s: &[Vec3; 3], span: &[(f32, f32); 3], lanes: &Lanes, maybe: &m
         let outside = {
             let (lo, hi) = span[lanes.kz[j] as usize];
             let (z1, z2) = (lo * lanes.sz[j], hi * lanes.sz[j]);
+            // (Both finite, so not NaN, before `min` and `max`, which pass NaN over.)
+            let finite = z1.abs() <= f32::MAX && z2.abs() <= f32::MAX;
             let (zlo, zhi) = (z1.min(z2), z1.max(z2));
-            let m = T_MARGIN * zlo.abs().max(zhi.abs());
-            zlo > 1.0 - SEGMENT_EPS + m || zhi < SEGMENT_EPS - m
+            finite && (zlo >= Z_FAR || zhi <= Z_NEAR)
         };
         if outside || pos && neg {
             maybe[j / 64] &= !(1 << (j % 64));
@@ -630,7 +645,7 @@ unsafe fn misses_avx(s: &[Vec3; 3], span: &[(f32, f32); 3], lanes: &Lanes, maybe
     // The spans' bounds in lanes 0-2, picked per lane by one permutation of lanes.
     let xyz = |v: [f32; 3]| _mm256_castps128_ps256(_mm_setr_ps(v[0], v[1], v[2], 0.0));
     let (lo, hi) = (xyz(span.map(|s| s.0)), xyz(span.map(|s| s.1)));
-    let (t_min, t_max, t_margin) = (sp(SEGMENT_EPS), sp(1.0 - SEGMENT_EPS), sp(T_MARGIN));
+    let (z_near, z_far, big) = (sp(Z_NEAR), sp(Z_FAR), sp(f32::MAX));
     let mut j = 0;
     while j < n && j / 64 < maybe.len() {
         if maybe[j / 64] >> (j % 64) & 0xff == 0 {
@@ -668,11 +683,14 @@ unsafe fn misses_avx(s: &[Vec3; 3], span: &[(f32, f32); 3], lanes: &Lanes, maybe
             let (lo, hi) = (_mm256_permutevar8x32_ps(lo, kz), _mm256_permutevar8x32_ps(hi, kz));
             let (z1, z2) = (_mm256_mul_ps(lo, sz), _mm256_mul_ps(hi, sz));
             let (zlo, zhi) = (_mm256_min_ps(z1, z2), _mm256_max_ps(z1, z2));
+            // As `misses_scalar`: both finite (false for NaN, which `min` and `max` pass over),
+            // and beyond a bound.
             let abs = |v| _mm256_andnot_ps(sign, v);
-            let m = _mm256_mul_ps(t_margin, _mm256_max_ps(abs(zlo), abs(zhi)));
-            let far = _mm256_cmp_ps::<_CMP_GT_OQ>(zlo, _mm256_add_ps(t_max, m));
-            let near = _mm256_cmp_ps::<_CMP_LT_OQ>(zhi, _mm256_sub_ps(t_min, m));
-            miss = _mm256_or_ps(miss, _mm256_or_ps(far, near));
+            let finite =
+                _mm256_and_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(abs(z1), big), _mm256_cmp_ps::<_CMP_LE_OQ>(abs(z2), big));
+            let far = _mm256_cmp_ps::<_CMP_GE_OQ>(zlo, z_far);
+            let near = _mm256_cmp_ps::<_CMP_LE_OQ>(zhi, z_near);
+            miss = _mm256_or_ps(miss, _mm256_and_ps(finite, _mm256_or_ps(far, near)));
         }
         let miss = _mm256_movemask_ps(miss) as u64;
         maybe[j / 64] &= !((miss & 0xff) << (j % 64));
@@ -979,6 +997,58 @@ mod tests {
             }
         }
         assert!(cleared > 1000 && kept > 100, "{cleared} cleared, {kept} kept");
+    }
+
+    /// Where the span test clears a lane, the watertight test misses, also where the edge
+    /// functions fall below the normal range: a triangle a few `10^-21` wide across the rays, at
+    /// `0.99 SEGMENT_EPS` along them (whose three rounded products once made a hit at `t = 1.5e-4`
+    /// that a bound relative to the `z_i` culled) and just beyond the light; and ordinary triangles
+    /// at and about both ends of the segment. The lanes cleared and the hits both occur.
+    #[test]
+    fn span_test_clears_only_misses_below_the_normal_range() {
+        use crate::geometry::RayTest;
+        let dirs = [Vec3::Z, Vec3::new(1e-3, -2e-3, 1.0), Vec3::new(0.3, 0.1, 1.0), Vec3::new(-0.2, 0.4, -1.0)];
+        let d: Vec<Vec3> = (0..LANES).map(|j| dirs[j % dirs.len()] * (1.0 + j as f32 * 0.125)).collect();
+        let tests: Vec<RayTest> =
+            d.iter().map(|&d| RayTest::new(Vec3::ZERO, d, SEGMENT_EPS, 1.0 - SEGMENT_EPS)).collect();
+        let kz: Vec<u32> = tests.iter().map(|t| t.shear().1[2]).collect();
+        let sz: Vec<f32> = tests.iter().map(|t| t.shear().0[2]).collect();
+        let (x, y, z): (Vec<f32>, Vec<f32>, Vec<f32>) = d.iter().map(|d| (d.x, d.y, d.z)).collect();
+        let len: Vec<f32> = d.iter().map(|d| d.length()).collect();
+        let lanes = Lanes { x: &x, y: &y, z: &z, len: &len, sz: &sz, kz: &kz };
+        let (mut cleared, mut hits) = (0, 0);
+        let tiny = (0..4000).map(|i| 2.0e-21 + i as f32 * 2e-25);
+        let wide = (0..400).map(|i| 1e-3 + i as f32 * 2.5e-3);
+        for p in tiny.chain(wide) {
+            for t in [0.0, 1e-6, 1.2e-5, 1.3e-5, 0.5e-4, 0.99e-4, 1e-4, 1.01e-4, 0.9999, 0.99991, 0.999911, 1.0, 1.0001]
+            {
+                for (j, ray) in d.iter().enumerate() {
+                    // Across ray `j` at parameter `t` (its `z_i` are `t`, up to rounding).
+                    let c = *ray * t;
+                    let tri = Triangle::new(
+                        c + Vec3::new(p, 0.0, 0.0),
+                        c + Vec3::new(-p, p, 0.0),
+                        c + Vec3::new(-p, -p, 0.0),
+                    );
+                    let (a, b, cc) = (tri.v[0], tri.v[1], tri.v[2]);
+                    let (lo, hi) = (a.min(b).min(cc), a.max(b).max(cc));
+                    let span = [(lo.x, hi.x), (lo.y, hi.y), (lo.z, hi.z)];
+                    // Edge normals that clear no lane by themselves: only the span test decides.
+                    let none = [Vec3::ZERO; 3];
+                    for simd in [None, Avx2::detect()] {
+                        let mut maybe = [(1u64 << LANES) - 1];
+                        misses(&none, &span, &lanes, &mut maybe, simd);
+                        let hit = tests[j].hit(&tri).is_some();
+                        hits += usize::from(hit);
+                        if maybe[0] >> j & 1 == 0 {
+                            cleared += 1;
+                            assert!(!hit, "p {p:e}, t {t}, ray {ray}: cleared but hit");
+                        }
+                    }
+                }
+            }
+        }
+        assert!(cleared > 10_000 && hits > 1_000, "{cleared} cleared, {hits} hits");
     }
 
     /// The shear lanes are [`crate::geometry::RayTest::new`]'s, bit for bit, on ordinary, tied,

@@ -524,9 +524,9 @@ impl Fan {
                 return;
             }
             // The watertight test's hit parameter is a weighted mean of the vertices' `p[kz] / d[kz]`
-            // (computed as it computes them); lanes where all of them lie outside the segment's range
-            // (beyond a margin for the mean's rounding) miss. Per axis, the least and greatest vertex
-            // coordinate.
+            // (computed as it computes them); lanes where all of them lie well before the segment's
+            // range or beyond the light miss, whatever the roundings (`lanes::Z_NEAR`,
+            // `lanes::Z_FAR`). Per axis, the least and greatest vertex coordinate.
             let (lo, hi) = (a.min(b).min(c), a.max(b).max(c));
             let span = [(lo.x, hi.x), (lo.y, hi.y), (lo.z, hi.z)];
             // The open rays of the mask, less the sure misses.
