@@ -403,6 +403,33 @@ pub(crate) fn nonzero_bytes(m: u64) -> u8 {
     ((top >> 7).wrapping_mul(0x0102_0408_1020_4080) >> 56) as u8
 }
 
+/// Bit `c` set where `m[c]` is not zero (the boxes that a ray meets, from [`meets_boxes`]'s masks).
+#[inline(always)]
+pub(super) fn nonzero_words(m: &[u64; 8], simd: Option<Avx2>) -> u8 {
+    #[cfg(target_arch = "x86_64")]
+    if simd.is_some() {
+        // SAFETY: AVX2 is available (the proof).
+        return unsafe { nonzero_words_avx(m) };
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = simd;
+    m.iter().enumerate().fold(0, |b, (c, &w)| b | u8::from(w != 0) << c)
+}
+
+/// [`nonzero_words`] with two compares of four words.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx,avx2")]
+#[inline]
+unsafe fn nonzero_words_avx(m: &[u64; 8]) -> u8 {
+    use std::arch::x86_64::*;
+    // SAFETY: eight words, read as two vectors of four.
+    let (a, b) = unsafe { (_mm256_loadu_si256(m.as_ptr().cast()), _mm256_loadu_si256(m.as_ptr().add(4).cast())) };
+    let zero = _mm256_setzero_si256();
+    let za = _mm256_movemask_pd(_mm256_castsi256_pd(_mm256_cmpeq_epi64(a, zero)));
+    let zb = _mm256_movemask_pd(_mm256_castsi256_pd(_mm256_cmpeq_epi64(b, zero)));
+    !((za | zb << 4) as u8)
+}
+
 /// `out[c]` becomes `meets(lo_c, hi_c)` for each box `c` with bit `c` of `alive` set, 0 for the
 /// others (the loop of [`meets_boxes`], inlined into each of its two paths).
 #[inline(always)]
@@ -806,6 +833,17 @@ mod tests {
                     std::array::from_fn(|c| if pattern >> c & 1 != 0 { value.rotate_left(c as u32) } else { 0 });
                 let want = bytes.iter().enumerate().fold(0u8, |b, (c, &m)| b | u8::from(m != 0) << c);
                 assert_eq!(nonzero_bytes(u64::from_le_bytes(bytes)), want, "{bytes:?}");
+            }
+        }
+    }
+
+    /// [`nonzero_words`] marks the non-zero words, with and without AVX2.
+    #[test]
+    fn nonzero_words_marks_every_nonzero_word() {
+        for pattern in 0..=255u8 {
+            let words: [u64; 8] = std::array::from_fn(|c| if pattern >> c & 1 != 0 { 1u64 << (c * 9 % 64) } else { 0 });
+            for simd in [None, Avx2::detect()] {
+                assert_eq!(nonzero_words(&words, simd), pattern, "{words:?}");
             }
         }
     }

@@ -38,6 +38,7 @@ use crate::scene::{Scene, TriId};
 
 pub use super::pyramid::Pyramid;
 pub(crate) use lanes::nonzero_bytes;
+use lanes::nonzero_words;
 
 mod lanes;
 
@@ -410,9 +411,7 @@ impl Fan {
                     to[c * w + i] = o;
                 }
             }
-            for (c, &o) in out.iter().enumerate() {
-                hit |= u8::from(o != 0) << c;
-            }
+            hit |= nonzero_words(&out, simd);
         }
         hit
     }
