@@ -3,7 +3,7 @@
 //! query, not by a run-time check at every node and triangle (which also kept the compiler from
 //! treating the walk as AVX2 code throughout).
 
-use std::sync::atomic::{AtomicU8, Ordering};
+use std::sync::OnceLock;
 
 /// Held only where the CPU has AVX2, POPCNT and BMI1 ([`Avx2::detect`]).
 #[derive(Clone, Copy, Debug)]
@@ -15,28 +15,18 @@ impl Avx2 {
     /// features' answer is kept as one, so that asking costs one load.)
     #[inline]
     pub(crate) fn detect() -> Option<Avx2> {
-        match KNOWN.load(Ordering::Relaxed) {
-            YES => Some(Avx2(())),
-            NO => None,
-            _ => Avx2::find(),
-        }
+        static HAS: OnceLock<bool> = OnceLock::new();
+        HAS.get_or_init(Avx2::find).then_some(Avx2(()))
     }
 
-    /// [`Avx2::detect`]'s first answer, kept in [`KNOWN`].
+    /// Whether the CPU has the three features ([`Avx2::detect`]'s first answer).
     #[cold]
-    fn find() -> Option<Avx2> {
+    fn find() -> bool {
         #[cfg(target_arch = "x86_64")]
-        let has = std::arch::is_x86_feature_detected!("avx2")
+        return std::arch::is_x86_feature_detected!("avx2")
             && std::arch::is_x86_feature_detected!("popcnt")
             && std::arch::is_x86_feature_detected!("bmi1");
         #[cfg(not(target_arch = "x86_64"))]
-        let has = false;
-        KNOWN.store(if has { YES } else { NO }, Ordering::Relaxed);
-        has.then_some(Avx2(()))
+        false
     }
 }
-
-/// Whether the CPU has the features: not yet asked (0), [`NO`] or [`YES`].
-static KNOWN: AtomicU8 = AtomicU8::new(0);
-const NO: u8 = 1;
-const YES: u8 = 2;
