@@ -242,12 +242,15 @@ impl<'a> Mesh<'a> {
     /// or not planar within `tol`, or (if given) its area differs from `area`.
     fn convex_polygon(&self, ids: &[u32], tol: f32, area: Option<f32>) -> Option<Vec<Vec3>> {
         let mut p: Vec<Vec3> = ids.iter().map(|&i| self.pos[i as usize]).collect();
-        let mut n = Vec3::ZERO;
+        // Newell's normal, relative to the first vertex and in f64 (from the origin, a small light
+        // far away would sum terms of its distance squared that cancel to noise).
+        let p0 = p[0].as_dvec3();
+        let mut n = glam::DVec3::ZERO;
         for i in 0..p.len() {
-            n += p[i].cross(p[(i + 1) % p.len()]);
+            n += (p[i].as_dvec3() - p0).cross(p[(i + 1) % p.len()].as_dvec3() - p0);
         }
-        let loop_area = 0.5 * n.length();
-        let n = n.normalize_or_zero();
+        let loop_area = (0.5 * n.length()) as f32;
+        let n = n.normalize_or_zero().as_vec3();
         if n == Vec3::ZERO {
             return None;
         }
@@ -415,6 +418,18 @@ mod tests {
         assert_eq!(pos.len(), 4);
         assert_eq!(ids[0], ids[3]);
         assert_eq!(ids[2], ids[4]);
+    }
+
+    /// A small square of two triangles far from the origin is one light of four corners (Newell's
+    /// sum from the origin cancelled to noise there: it fell apart into its triangles).
+    #[test]
+    fn small_square_far_from_the_origin_is_one_light() {
+        let (x, y, z, s) = (432.5f32, -740.8f32, -874.6f32, 0.2f32);
+        let a = tri(0, [x, y, z], [x, y + s, z], [x, y + s, z + s]);
+        let b = tri(1, [x, y, z], [x, y + s, z + s], [x, y, z + s]);
+        let lights = group_lights(&[a, b]).unwrap();
+        assert_eq!(lights.len(), 1, "{lights:?}");
+        assert_eq!(lights[0].polygon.len(), 4, "{lights:?}");
     }
 
     #[test]

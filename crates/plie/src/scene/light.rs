@@ -51,26 +51,32 @@ impl Light {
         if !radiance.is_finite() || radiance.min_element() < 0.0 || radiance.max_element() <= 0.0 {
             return Err(bad(&format!("radiance {radiance} must be finite, non-negative and not zero")));
         }
-        // Newell normal: robust for any planar polygon.
-        let mut n = Vec3::ZERO;
+        // Newell normal: robust for any planar polygon. Taken relative to the first vertex and in
+        // f64: from the origin, the terms of a small light far away would be as large as its
+        // distance squared and cancel to rounding noise.
+        let v0 = vertices[0].as_dvec3();
+        let mut n = glam::DVec3::ZERO;
         for (i, a) in vertices.iter().enumerate() {
-            n += a.cross(vertices[(i + 1) % vertices.len()]);
+            n += (a.as_dvec3() - v0).cross(vertices[(i + 1) % vertices.len()].as_dvec3() - v0);
         }
-        let area = 0.5 * n.length();
+        let area = (0.5 * n.length()) as f32;
         let size = extent(&vertices);
         if area.is_nan() || area <= 1e-10 * size * size {
             return Err(bad("zero area"));
         }
-        let normal = n / (2.0 * area);
+        let normal = n.normalize().as_vec3();
+        // How far rounding the corners to f32 may have moved them: a small light far from the
+        // origin is planar and convex only up to that.
+        let rounding = 4.0 * f32::EPSILON * vertices.iter().fold(0.0f32, |m, v| m.max(v.abs().max_element()));
         for v in &vertices {
-            if (*v - vertices[0]).dot(normal).abs() > 1e-4 * size {
+            if (*v - vertices[0]).dot(normal).abs() > (1e-4 * size).max(rounding) {
                 return Err(bad("vertices are not coplanar"));
             }
         }
         let k = vertices.len();
         for i in 0..k {
             let (a, b, c) = (vertices[i], vertices[(i + 1) % k], vertices[(i + 2) % k]);
-            if (b - a).cross(c - b).dot(normal) < -1e-6 * size * size {
+            if (b - a).cross(c - b).dot(normal) < -(1e-6 * size * size).max(4.0 * rounding * size) {
                 return Err(bad("polygon is not convex"));
             }
         }
@@ -83,8 +89,12 @@ impl Light {
         for c in &mut fan_cdf {
             *c /= acc;
         }
-        let parallelogram =
-            k == 4 && ((vertices[0] + vertices[2]) - (vertices[1] + vertices[3])).length() <= 1e-5 * size;
+        // `v0 + v2 - v1 - v3` from differences, in f64 (the sums of coordinates far from the origin
+        // would round away what is tested).
+        let parallelogram = k == 4 && {
+            let d = |i: usize, j: usize| vertices[i].as_dvec3() - vertices[j].as_dvec3();
+            (d(2, 1) - d(3, 0)).length() <= 1e-5 * size as f64
+        };
         Ok(Light { vertices, normal, area, radiance, triangles, fan_cdf, parallelogram })
     }
 
@@ -161,6 +171,45 @@ mod tests {
         assert!((l.normal - Vec3::Y).length() < 1e-6);
         let p = l.sample(Vec2::new(0.25, 0.75));
         assert!(p.y.abs() < 1e-7 && (0.0..=1.0).contains(&p.x) && (0.0..=1.0).contains(&p.z));
+    }
+
+    /// A light small against its distance from the origin keeps its area and normal (the Newell
+    /// sum from the origin cancelled to noise: such lights were refused as of zero area or not
+    /// planar, or got a wrong normal).
+    #[test]
+    fn small_light_far_from_the_origin() {
+        for (far, size) in [(Vec3::new(432.5, -740.8, -874.6), 0.2), (Vec3::new(-147_218.0, -20_539.4, -36_335.1), 0.1)]
+        {
+            for (u, v) in [(Vec3::Y, Vec3::Z), (Vec3::Z, Vec3::X), (Vec3::X, Vec3::Y)] {
+                let normal = u.cross(v);
+                // Counter-clockwise around `normal`.
+                let quad = vec![far, far + u * size, far + (u + v) * size, far + v * size];
+                // The area of the rectangle the rounded corners make.
+                let side = |k: usize| (quad[k].as_dvec3() - quad[0].as_dvec3()).length();
+                let area = side(1) * side(3);
+                let l = Light::new(quad, Vec3::ONE, vec![]).unwrap_or_else(|e| panic!("{normal}: {e}"));
+                assert!((l.area as f64 / area - 1.0).abs() < 1e-4, "{normal}: area {} for {area}", l.area);
+                assert!(l.normal.dot(normal) > 0.9999, "{normal}: normal {}", l.normal);
+            }
+        }
+    }
+
+    /// A small light turned any way, far from the origin, is planar and convex up to the rounding
+    /// of its corners to f32, and is accepted.
+    #[test]
+    fn small_turned_light_far_from_the_origin() {
+        let far = Vec3::new(36.48, 52.03, 23.85);
+        for k in 0..200 {
+            let a = k as f32 * 0.37;
+            let rot = glam::Mat3::from_euler(glam::EulerRot::XYZ, a, a * 1.7, a * 2.3);
+            let size = 0.01;
+            let quad: Vec<Vec3> = [(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)]
+                .iter()
+                .map(|&(u, v)| far + rot * Vec3::new(u * size, v * size, 0.0))
+                .collect();
+            let l = Light::new(quad, Vec3::ONE, vec![]).unwrap_or_else(|e| panic!("turn {k}: {e}"));
+            assert!(l.normal.dot(rot * Vec3::Z) > 0.999, "turn {k}: normal {}", l.normal);
+        }
     }
 
     #[test]
