@@ -98,6 +98,30 @@ impl Light {
         Ok(Light { vertices, normal, area, radiance, triangles, fan_cdf, parallelogram })
     }
 
+    /// How far the light is from a planar convex polygon (what [`Light::new`] allows for the
+    /// rounding of its corners): the largest distance of a corner from the light's plane, or of a
+    /// corner outside the line of the edge before it; computed in f64.
+    pub(crate) fn deviation(&self) -> f32 {
+        let v: Vec<glam::DVec3> = self.vertices.iter().map(|v| v.as_dvec3()).collect();
+        let n = self.normal.as_dvec3();
+        let k = v.len();
+        let mut dev = 0.0f64;
+        for i in 0..k {
+            dev = dev.max((v[i] - v[0]).dot(n).abs());
+            let (a, b, c) = (v[i], v[(i + 1) % k], v[(i + 2) % k]);
+            let len = (b - a).length();
+            if len > 0.0 {
+                dev = dev.max(-(b - a).cross(c - b).dot(n) / len);
+            }
+        }
+        dev as f32
+    }
+
+    /// The size of the light: the largest extent of its corners' bounding box.
+    pub(crate) fn size(&self) -> f32 {
+        extent(&self.vertices)
+    }
+
     /// For a parallelogram, its corner `v0` and edge vectors `v1 - v0`, `v3 - v0`: [`Light::sample`]
     /// maps `u` to `v0 + (v1 - v0) u.x + (v3 - v0) u.y`. `None` for other polygons.
     pub fn parallelogram_edges(&self) -> Option<(Vec3, Vec3, Vec3)> {
@@ -210,6 +234,34 @@ mod tests {
             let l = Light::new(quad, Vec3::ONE, vec![]).unwrap_or_else(|e| panic!("turn {k}: {e}"));
             assert!(l.normal.dot(rot * Vec3::Z) > 0.999, "turn {k}: normal {}", l.normal);
         }
+    }
+
+    /// A light flat and convex only up to its corners' rounding is accepted where that is within
+    /// the scene's tolerance, and refused with a clear error where it is not.
+    #[test]
+    fn rounding_of_a_light_within_the_scene_tolerance() {
+        let scene = |at: Vec3, k: usize| {
+            let a = k as f32 * 0.37;
+            let rot = glam::Mat3::from_euler(glam::EulerRot::XYZ, a, a * 1.7, a * 2.3);
+            let mut b = crate::scene::SceneBuilder::new("far");
+            let w = b.diffuse("w", Vec3::splat(0.5));
+            b.triangle(at, at + Vec3::X, at + Vec3::Z, w);
+            let quad: Vec<Vec3> = [(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)]
+                .iter()
+                .map(|&(u, v)| at + Vec3::Y + rot * Vec3::new(u * 0.01, v * 0.01, 0.0))
+                .collect();
+            b.light("l", &quad, Vec3::ONE);
+            b.build()
+        };
+        let mut refused = 0;
+        for k in 0..50 {
+            assert!(scene(Vec3::new(30.0, 50.0, 20.0), k).is_ok(), "turn {k}");
+            if let Err(e) = scene(Vec3::splat(5000.0), k) {
+                assert!(e.to_string().contains("too small for its distance from the origin"), "{e}");
+                refused += 1;
+            }
+        }
+        assert!(refused > 10, "{refused} of 50 refused");
     }
 
     #[test]

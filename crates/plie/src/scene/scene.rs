@@ -7,7 +7,7 @@ use glam::{Vec2, Vec3};
 
 use super::{Camera, Light, LightId, Material, MaterialId, Texture, TextureId, TriId};
 use crate::error::{Error, Result};
-use crate::geometry::{Aabb, Triangle};
+use crate::geometry::{Aabb, Triangle, TOLERANCE_REL};
 
 /// A validated scene: flat arrays indexed by [`TriId`], [`MaterialId`] and [`LightId`].
 #[derive(Clone, Debug)]
@@ -273,6 +273,21 @@ impl SceneBuilder {
             return bad("every triangle of the scene is degenerate".into());
         }
         let bounds = triangles.iter().fold(Aabb::EMPTY, |b, t| b.union(t.aabb()));
+        // A light planar and convex only up to the rounding of its corners (one small against its
+        // distance from the origin, see `Light::new`) must be so within a quarter of the margin the
+        // per-light queries grow their pyramids by (ten tolerances), so that its samples stay
+        // inside that pyramid; a light within `1e-4` of its own size is so in any scene holding it.
+        let tol = 2.5 * TOLERANCE_REL * bounds.size().max_element();
+        for (li, l) in lights.iter().enumerate() {
+            let dev = l.deviation();
+            if dev > tol.max(1e-4 * l.size()) {
+                return bad(format!(
+                    "light {li} is too small for its distance from the origin: rounded to f32, its corners lie \
+                     up to {dev} off a flat convex polygon, more than this scene's tolerance ({tol}) allows; \
+                     move the scene nearer the origin"
+                ));
+            }
+        }
         Ok(Scene {
             name: self.name,
             triangles,
