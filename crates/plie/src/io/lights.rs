@@ -25,6 +25,7 @@ use std::collections::HashMap;
 
 use glam::Vec3;
 
+use crate::geometry::newell;
 use crate::scene::{SceneBuilder, TriId};
 
 /// An emissive triangle as a loader found it: already added to the [`SceneBuilder`] as `id`, with its
@@ -242,13 +243,7 @@ impl<'a> Mesh<'a> {
     /// or not planar within `tol`, or (if given) its area differs from `area`.
     fn convex_polygon(&self, ids: &[u32], tol: f32, area: Option<f32>) -> Option<Vec<Vec3>> {
         let mut p: Vec<Vec3> = ids.iter().map(|&i| self.pos[i as usize]).collect();
-        // Newell's normal, relative to the first vertex and in f64 (from the origin, a small light
-        // far away would sum terms of its distance squared that cancel to noise).
-        let p0 = p[0].as_dvec3();
-        let mut n = glam::DVec3::ZERO;
-        for i in 0..p.len() {
-            n += (p[i].as_dvec3() - p0).cross(p[(i + 1) % p.len()].as_dvec3() - p0);
-        }
+        let n = newell(&p);
         let loop_area = (0.5 * n.length()) as f32;
         let n = n.normalize_or_zero().as_vec3();
         if n == Vec3::ZERO {

@@ -7,6 +7,7 @@ use serde::{Deserialize, Serialize};
 
 use super::TriId;
 use crate::error::{Error, Result};
+use crate::geometry::newell;
 
 /// A one-sided convex polygonal area light.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -51,14 +52,8 @@ impl Light {
         if !radiance.is_finite() || radiance.min_element() < 0.0 || radiance.max_element() <= 0.0 {
             return Err(bad(&format!("radiance {radiance} must be finite, non-negative and not zero")));
         }
-        // Newell normal: robust for any planar polygon. Taken relative to the first vertex and in
-        // f64: from the origin, the terms of a small light far away would be as large as its
-        // distance squared and cancel to rounding noise.
-        let v0 = vertices[0].as_dvec3();
-        let mut n = glam::DVec3::ZERO;
-        for (i, a) in vertices.iter().enumerate() {
-            n += (a.as_dvec3() - v0).cross(vertices[(i + 1) % vertices.len()].as_dvec3() - v0);
-        }
+        // Newell normal: robust for any planar polygon, and for one far from the origin.
+        let n = newell(&vertices);
         let area = (0.5 * n.length()) as f32;
         let size = extent(&vertices);
         if area.is_nan() || area <= 1e-10 * size * size {
@@ -102,13 +97,13 @@ impl Light {
     /// rounding of its corners): the largest distance of a corner from the light's plane, or of a
     /// corner outside the line of the edge before it; computed in f64.
     pub(crate) fn deviation(&self) -> f32 {
-        let v: Vec<glam::DVec3> = self.vertices.iter().map(|v| v.as_dvec3()).collect();
+        let k = self.vertices.len();
+        let v = |i: usize| self.vertices[i % k].as_dvec3();
         let n = self.normal.as_dvec3();
-        let k = v.len();
         let mut dev = 0.0f64;
         for i in 0..k {
-            dev = dev.max((v[i] - v[0]).dot(n).abs());
-            let (a, b, c) = (v[i], v[(i + 1) % k], v[(i + 2) % k]);
+            dev = dev.max((v(i) - v(0)).dot(n).abs());
+            let (a, b, c) = (v(i), v(i + 1), v(i + 2));
             let len = (b - a).length();
             if len > 0.0 {
                 dev = dev.max(-(b - a).cross(c - b).dot(n) / len);
