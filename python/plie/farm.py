@@ -114,6 +114,10 @@ def render_frames(
     }
 
 
+#: Most frames one run renders (and checks before it starts), as `plie render --camera-path`.
+MAX_FRAMES = 1_000_000
+
+
 def check_inputs(camera_path: str, output: str, frames: Optional[Tuple[int, int]]) -> Tuple[str, Tuple[int, int]]:
     """Checks a walkthrough's inputs before any work (as `plie render --camera-path` does): the
     output pattern and folder, the camera path, the frame range and every frame's camera. Returns the
@@ -129,6 +133,11 @@ def check_inputs(camera_path: str, output: str, frames: Optional[Tuple[int, int]
     a, b = frames if frames is not None else (first, last)
     if a < first or b > last:
         raise ValueError(f"--frames {a}..{b} is outside the camera path's frames {first}..{last} ({camera_path})")
+    if b - a + 1 > MAX_FRAMES:
+        raise ValueError(
+            f"--frames {a}..{b} asks for {b - a + 1} frames of {camera_path}; one run renders at most {MAX_FRAMES}"
+            " (give a smaller --frames range)"
+        )
     for f in range(a, b + 1):
         path.camera(f)
     return path_json, (a, b)

@@ -125,3 +125,8 @@ def test_the_command_line_rejects_bad_input_before_starting_ray(tmp_path, capsys
     assert plie.farm.main(["--scene", "cornell-cube-2", "--camera-path", str(tmp_path / "none.json"),
                            "-o", str(tmp_path / "f#.png")]) == 1
     assert "none.json" in capsys.readouterr().err
+    # A path of 4,294,967,296 frames: an error at once, not a check of every frame's camera.
+    long = tmp_path / "long.json"
+    long.write_text(PATH.replace('"frame": 3', '"frame": 4294967295'))
+    assert plie.farm.main(["--scene", "cornell-cube-2", "--camera-path", str(long), "-o", str(tmp_path / "f#.png")]) == 1
+    assert "at most 1000000" in capsys.readouterr().err

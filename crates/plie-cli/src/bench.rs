@@ -38,9 +38,10 @@ pub struct Args {
     /// Directory for report.md, results.csv, results.json and shading.svg (created if missing).
     #[arg(long, default_value = "bench-out", value_name = "DIR")]
     out: PathBuf,
-    /// Runs per measurement; the median is reported (default 5, 1 with --quick and with --path).
-    #[arg(long, value_name = "N")]
-    runs: Option<usize>,
+    /// Runs per measurement, 1 to 1000; the median is reported (default 5, 1 with --quick and with
+    /// --path).
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=1000))]
+    runs: Option<u32>,
     #[command(flatten)]
     threads: crate::threads_arg::ThreadsArg,
     /// Directory of the thesis' figures (construction.tsv, shading-times.tsv).
@@ -73,7 +74,7 @@ pub struct Args {
 
 /// The plan `a` asks for.
 fn plan(a: &Args) -> Result<Plan> {
-    let runs = a.runs.unwrap_or(if a.quick { 1 } else { 5 });
+    let runs = a.runs.map_or(if a.quick { 1 } else { 5 }, |r| r as usize);
     anyhow::ensure!(runs >= 1, "--runs must be at least 1");
     let scenes = match (a.scenes.is_empty(), a.quick) {
         (false, _) => a.scenes.clone(),
@@ -91,7 +92,7 @@ pub fn run(a: &Args) -> Result<()> {
     std::fs::create_dir_all(&a.out).with_context(|| format!("cannot create directory {}", a.out.display()))?;
     if a.soft_shadows {
         let scenes = if a.scenes.is_empty() { crate::bench_soft::default_scenes(&a.shared) } else { a.scenes.clone() };
-        let runs = a.runs.unwrap_or(if a.quick { 1 } else { 3 });
+        let runs = a.runs.map_or(if a.quick { 1 } else { 3 }, |r| r as usize);
         anyhow::ensure!(runs >= 1, "--runs must be at least 1");
         return crate::bench_soft::run(&scenes, &a.out, runs, a.quiet);
     }
@@ -101,7 +102,7 @@ pub fn run(a: &Args) -> Result<()> {
     }
     let one = rayon::ThreadPoolBuilder::new().num_threads(1).build()?;
     let bar = Bar::new(a.quiet);
-    bar.start("bench", plan.steps_per_scene() * plan.scenes.len() as u64);
+    bar.start("bench", plan.steps_per_scene(rayon::current_num_threads()) * plan.scenes.len() as u64);
     let mut scenes = Vec::new();
     for name in &plan.scenes {
         scenes.push(bench_scene(name, &plan, &one, &bar).with_context(|| format!("scene {name}"))?);
@@ -147,7 +148,7 @@ fn run_path(a: &Args, plan: Plan) -> Result<()> {
         shadow_rays: 4,
         depths: vec![3, 5],
         modes,
-        runs: a.runs.unwrap_or(1),
+        runs: a.runs.map_or(1, |r| r as usize),
     };
     crate::bench_path::run(&p, &a.out, &Bar::new(a.quiet))?;
     if !a.quiet {
@@ -236,7 +237,8 @@ fn bench_scene(name: &str, plan: &Plan, one: &rayon::ThreadPool, bar: &Bar) -> R
             for &n in &plan.shadow_rays {
                 shading.push(time_shading(&scene, &hits, vis.as_ref(), (mode, size, n), plan.runs));
                 bar.advance(1);
-                if (size, n) == plan.throughput_setting() {
+                // One thread apart, unless all threads are one (the row above is that run).
+                if (size, n) == plan.throughput_setting() && rayon::current_num_threads() > 1 {
                     single.push(one.install(|| time_shading(&scene, &hits, vis.as_ref(), (mode, size, n), plan.runs)));
                     bar.advance(1);
                 }

@@ -29,10 +29,11 @@ impl Plan {
     }
 
     /// Progress steps per scene.
-    pub fn steps_per_scene(&self) -> u64 {
+    pub fn steps_per_scene(&self, threads: usize) -> u64 {
         let m = self.modes.len() as u64;
         let settings = (self.sizes.len() * self.shadow_rays.len()) as u64;
-        1 + m * settings + m + self.refined_modes.len() as u64 * settings
+        let single = if threads > 1 { m } else { 0 };
+        1 + m * settings + single + self.refined_modes.len() as u64 * settings
     }
 }
 

@@ -148,8 +148,8 @@ fn markdown(plan: &PathPlan, rows: &[PathRow]) -> String {
         "Path tracing: {0}x{0}, {1} paths per pixel, {2} shadow rays at every vertex on a light chosen by power, \
          no Russian roulette, {3} threads, median of {4} runs. Shadow time: summed over threads, timed around each \
          `occluded_light` call; total - none: the total minus that of mode `none` (same rays, no shadow test); \
-         shadow share: of the summed path-tracing time. Embree: when the embree mode lands, \
-         add it with `--path-modes`.\n",
+         shadow share: of the summed path-tracing time. More modes (`embree`, the P-LIE modes): \
+         `--path-modes`.\n",
         plan.size,
         plan.spp,
         plan.shadow_rays,

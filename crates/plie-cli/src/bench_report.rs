@@ -380,10 +380,12 @@ fn throughput(s: &mut String, r: &Results) {
     let t = r.threads;
     let _ = writeln!(
         s,
-        "| scene | mode | 1 thread M/s | {t} threads M/s | {t} threads M/s per core |\n|---|---|---|---|---|"
+        "| scene | mode | 1 thread M/s | {all} M/s | {all} M/s per core |\n|---|---|---|---|---|",
+        all = crate::scenes::count(t, "thread")
     );
     for sc in &r.scenes {
-        for x in sc.shading.iter().filter(|x| x.threads == 1 && x.size == size && x.shadow_rays == rays) {
+        // One row per mode: with one thread in all, the all-threads row is the one-thread row.
+        for x in sc.shading.iter().filter(|x| x.threads == 1 && !x.refined && x.size == size && x.shadow_rays == rays) {
             let all = sc
                 .shading
                 .iter()

@@ -105,7 +105,7 @@ pub fn run(a: &Args) -> Result<()> {
         print!("{stats}");
         println!("build           {build_seconds:.3} s");
         println!(
-            "memory          {memory} bytes (octree {} + P-LIE {}); budget {budget} bytes",
+            "memory          {memory} bytes (octree {} + P-LIE {}); memory budget {budget} bytes (--memory-budget)",
             octree.memory_bytes(),
             plie.memory_bytes()
         );

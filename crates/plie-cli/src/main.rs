@@ -52,6 +52,13 @@ enum Command {
 }
 
 fn main() {
+    // Output piped into a reader that stops early (`plie scenes --json | head -1`) ends the process
+    // quietly, as for other command-line tools, instead of a panic in `println!`.
+    #[cfg(unix)]
+    // SAFETY: called first in `main`, before any other thread exists; SIG_DFL is a valid handler.
+    unsafe {
+        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
+    }
     let parsed = Cli::command().try_get_matches().and_then(|m| Cli::from_arg_matches(&m).map(|cli| (cli, m)));
     let (cli, matches) = match parsed {
         Ok(parsed) => parsed,

@@ -206,8 +206,13 @@ impl PlieArgs {
     /// the parameters a `.plie` file was built with (issue 18: the file describes itself, so options
     /// left at their defaults take the file's values). A contradiction is an error naming the option,
     /// the value given and the file's value.
-    pub fn check_file_params(&self, file: &PlieParams, matches: &ArgMatches, path: &Path) -> Result<()> {
+    pub fn check_file_params(&self, env: &Environment, scene: &Scene, matches: &ArgMatches, path: &Path) -> Result<()> {
+        let file = env.params();
         let given = |id: &str| matches.value_source(id) == Some(ValueSource::CommandLine);
+        // The file stores the build's clip budgets in clips, the options count them per triangle.
+        let triangles = scene.triangles.len().max(1);
+        let per_triangle = |c: Option<usize>| BlockerCap(c.map(|c| (c / triangles).min(u32::MAX as usize) as u32));
+        let limits = env.plie().limits;
         // (argument id, option, the value given, the file's value)
         let mut checks: Vec<(&str, &str, String, String)> = vec![
             ("max_triangles", "--max-triangles", self.max_triangles.to_string(), file.max_triangles.to_string()),
@@ -225,6 +230,8 @@ impl PlieArgs {
                 max_blockers_word(file.refine.blockers),
             ),
             ("blocker_cap", "--blocker-cap", self.blocker_cap.to_string(), BlockerCap(file.blocker_cap).to_string()),
+            ("lift_clips", "--lift-clips", self.lift_clips.to_string(), per_triangle(limits.lift_clips).to_string()),
+            ("cell_clips", "--cell-clips", self.cell_clips.to_string(), per_triangle(limits.cell_clips).to_string()),
         ];
         if given("refine") {
             let asked = RefineParams {
@@ -273,7 +280,7 @@ pub fn load_file(scene: &Scene, path: &Path, args: &PlieArgs, matches: &ArgMatch
     let t = Instant::now();
     let env =
         Environment::load(path, scene, None).with_context(|| format!("cannot use P-LIE file {}", path.display()))?;
-    args.check_file_params(env.params(), matches, path)?;
+    args.check_file_params(&env, scene, matches, path)?;
     Ok(Loaded { env, build_seconds: None, load_seconds: Some(t.elapsed().as_secs_f64()) })
 }
 

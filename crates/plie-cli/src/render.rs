@@ -5,8 +5,9 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use anyhow::{bail, Context, Result};
+use plie::octree::Octree;
 use plie::visibility::{Answer, QueryStats};
-use plie::{Camera, Environment, Mode, Renderer, Shadows, Timing};
+use plie::{Camera, Mode, Renderer, Shadows, Timing};
 use serde_json::json;
 
 use crate::image_args::ImageArgs;
@@ -84,7 +85,11 @@ pub fn run(a: &Args, matches: &clap::ArgMatches) -> Result<()> {
         a.scene.file().into_iter().chain(a.plie.as_deref()).chain(a.camera_path.as_deref()).collect();
     let walk = a.camera_path.as_deref().map(|p| Plan::new(p, a.frames, &a.output, a.resume)).transpose()?;
     match &walk {
-        Some(w) => crate::checks::output_is_not_input(&w.file(0), &inputs)?,
+        Some(w) => {
+            for file in w.existing_files() {
+                crate::checks::output_is_not_input(&file, &inputs)?;
+            }
+        }
         None => crate::checks::output_is_not_input(&a.output, &inputs)?,
     }
     let mut settings = a.image.settings()?;
@@ -107,7 +112,7 @@ pub fn run(a: &Args, matches: &clap::ArgMatches) -> Result<()> {
     let asked = a.visibility.unwrap_or(Mode::Bvh);
     let plie_file = if a.visibility.is_none_or(Mode::needs_plie) { a.plie.as_deref() } else { None };
     if !a.quiet {
-        for w in ignored_options(a, asked) {
+        for w in ignored_options(a, asked, matches) {
             eprintln!("warning: {w}");
         }
     }
@@ -126,7 +131,11 @@ pub fn run(a: &Args, matches: &clap::ArgMatches) -> Result<()> {
     let shadows = Shadows::with_octree_params(&scene, params.octree())?;
     let env = loaded.as_ref().map(|l| &l.env);
     let (plie_seconds, load_plie_seconds) = loaded.as_ref().map_or((None, None), |l| (l.build_seconds, l.load_seconds));
-    let octree = env.map_or_else(|| shadows.octree(), Environment::octree);
+    // The octree of mode `octree` or of the P-LIE; the other modes build none.
+    let octree = match env {
+        Some(env) => Some(env.octree()),
+        None => (asked == Mode::Octree).then(|| shadows.octree()),
+    };
     let octree_seconds = t.elapsed().as_secs_f64() - plie_seconds.unwrap_or(0.0);
     let t = Instant::now();
     let bvh = env.map_or_else(|| shadows.bvh(), |e| e.bvh(&scene));
@@ -139,7 +148,7 @@ pub fn run(a: &Args, matches: &clap::ArgMatches) -> Result<()> {
         None => (asked, shadows.visibility(asked)?),
     };
     // Only the P-LIE modes locate shaded points in the octree (the others do not use the leaf).
-    let leaves = mode.needs_plie().then_some(octree);
+    let leaves = octree.filter(|_| mode.needs_plie());
     let integrator = match a.path.integrator {
         Integrator::Path => plie::Integrator::Path(a.path.settings(settings.eye_rays)?),
         Integrator::Direct => plie::Integrator::Direct,
@@ -159,22 +168,26 @@ pub fn run(a: &Args, matches: &clap::ArgMatches) -> Result<()> {
         if a.json {
             let mut v = render_path::json_fields(&traced, &a.path, settings.eye_rays)?;
             v["scene"] = json!(scene.name);
+            v["triangles"] = json!(scene.triangle_count());
+            v["lights"] = json!(scene.lights.len());
             v["visibility"] = json!(mode.name());
             v["width"] = json!(settings.width);
             v["height"] = json!(settings.height);
             v["shadow_rays_per_light"] = json!(settings.shadow_rays);
             v["seed"] = json!(settings.seed);
             v["threads"] = json!(rayon::current_num_threads());
+            v["load_seconds"] = json!(load_seconds);
             v["build_seconds"] = json!(plie_seconds);
+            v["plie_load_seconds"] = json!(load_plie_seconds);
             v["output"] = json!(a.output.display().to_string());
             println!("{v}");
         }
         if a.stats {
             eprintln!(
-                "scene            {} ({} triangles, {} lights)",
+                "scene            {} ({} triangles, {})",
                 scene.name,
                 scene.triangle_count(),
-                scene.lights.len()
+                crate::scenes::count(scene.lights.len(), "light")
             );
             eprintln!("visibility       {}", mode);
             render_path::print_stats(&traced);
@@ -217,9 +230,9 @@ pub fn run(a: &Args, matches: &clap::ArgMatches) -> Result<()> {
             "threads": rayon::current_num_threads(),
             "load_seconds": load_seconds,
             "bvh_build_seconds": bvh_seconds,
-            "octree_build_seconds": octree_seconds,
-            "octree_leaves": octree.leaf_count(),
-            "octree_depth": octree.depth(),
+            "octree_build_seconds": octree.map(|_| octree_seconds),
+            "octree_leaves": octree.map(Octree::leaf_count),
+            "octree_depth": octree.map(Octree::depth),
             "build_seconds": plie_seconds,
             "plie_load_seconds": load_plie_seconds,
             "hit_buffer_seconds": hit_buffer_seconds,
@@ -258,7 +271,12 @@ pub fn run(a: &Args, matches: &clap::ArgMatches) -> Result<()> {
         eprintln!("threads          {}", rayon::current_num_threads());
         eprintln!("load             {load_seconds:.3} s");
         eprintln!("bvh build        {bvh_seconds:.3} s");
-        eprintln!("octree build     {octree_seconds:.3} s ({} leaves, depth {})", octree.leaf_count(), octree.depth());
+        match octree {
+            Some(o) => {
+                eprintln!("octree build     {octree_seconds:.3} s ({} leaves, depth {})", o.leaf_count(), o.depth())
+            }
+            None => eprintln!("octree build     none (--visibility {mode} uses no octree)"),
+        }
         if let Some(s) = plie_seconds {
             eprintln!("p-lie build      {s:.3} s");
         }
@@ -294,7 +312,7 @@ fn print_answers(s: &QueryStats) {
     }
     let per_ray = |n: u64| n as f64 / s.shadow_rays.max(1) as f64;
     eprintln!(
-        "  of which       {:.2} blockers, {:.2} own leaf per shadow ray",
+        "p-lie tests      {:.2} blocker and {:.2} own-leaf triangle tests per shadow ray",
         per_ray(s.blocker_tests),
         per_ray(s.own_leaf_tests)
     );
@@ -314,15 +332,21 @@ fn print_answers(s: &QueryStats) {
             ("shaft", l.shaft),
             ("last blockers", l.last_blockers),
             ("scene BVH", l.scene),
-            ("(unsought)", l.unsought),
         ] {
             eprintln!("  {name:<14} {n:>12} {:>6.1}%", share(n));
         }
+        eprintln!(
+            "  of all pairs, {} ({:.1}%) did not look for footprints (their leaf's footprints had decided nothing lately); they are among shaft, last blockers and scene BVH",
+            l.unsought,
+            share(l.unsought)
+        );
     }
 }
 
-/// Options given that the chosen mode does not use, as warnings.
-fn ignored_options(a: &Args, mode: Mode) -> Vec<String> {
+/// Options given on the command line (`matches`) that the chosen mode, integrator or output does not
+/// use, as warnings.
+fn ignored_options(a: &Args, mode: Mode, matches: &clap::ArgMatches) -> Vec<String> {
+    let given = |id: &str| matches.value_source(id) == Some(clap::parser::ValueSource::CommandLine);
     let mut out = Vec::new();
     let p = &a.params;
     let uses_plie = a.visibility.is_none_or(Mode::needs_plie) && (mode.needs_plie() || a.plie.is_some());
@@ -333,22 +357,55 @@ fn ignored_options(a: &Args, mode: Mode) -> Vec<String> {
         ));
     }
     if !uses_plie {
-        for (given, name) in [
-            (!p.refine.is_empty(), "--refine"),
-            (p.max_blockers.is_some(), "--max-blockers"),
-            (p.max_split_depth != crate::plie_args::DEFAULT_MAX_SPLIT_DEPTH, "--max-split-depth"),
-            (p.no_regions, "--no-regions"),
-            (p.no_propagation, "--no-propagation"),
-            (p.no_grids, "--no-grids"),
+        // --max-blockers without --refine blockers is an error (below), not a warning.
+        let max_blockers = p.max_blockers.is_some() && p.refine.contains(&crate::plie_args::RefineCriterion::Blockers);
+        for (id, name) in [
+            ("refine", "--refine"),
+            ("max_split_depth", "--max-split-depth"),
+            ("no_regions", "--no-regions"),
+            ("no_propagation", "--no-propagation"),
+            ("no_grids", "--no-grids"),
+            ("blocker_cap", "--blocker-cap"),
+            ("lift_clips", "--lift-clips"),
+            ("cell_clips", "--cell-clips"),
         ] {
-            if given {
+            if given(id) {
                 out.push(format!(
                     "{name} is ignored: --visibility {mode} builds no P-LIE (lie, umbra, penumbra and grid do)"
                 ));
             }
         }
+        if max_blockers {
+            out.push(format!(
+                "--max-blockers is ignored: --visibility {mode} builds no P-LIE (lie, umbra, penumbra and grid do)"
+            ));
+        }
+        if mode != Mode::Octree {
+            for (id, name) in [("max_triangles", "--max-triangles"), ("max_depth", "--max-depth")] {
+                if given(id) {
+                    out.push(format!(
+                        "{name} is ignored: --visibility {mode} builds no octree (octree and the P-LIE modes do)"
+                    ));
+                }
+            }
+        }
     } else if p.no_grids && a.visibility.is_some_and(|m| m != Mode::Grid) {
         out.push(format!("--no-grids is ignored: only --visibility grid uses face grids, not {mode}"));
+    }
+    if a.path.integrator == Integrator::Direct {
+        for (id, name) in [("nee", "--nee"), ("max_path_depth", "--max-path-depth"), ("rr_depth", "--rr-depth")] {
+            if given(id) {
+                out.push(format!("{name} is ignored: it sets the path tracer (--integrator path), not direct light"));
+            }
+        }
+    }
+    let linear = |p: &std::path::Path| {
+        p.extension()
+            .and_then(|e| e.to_str())
+            .is_some_and(|e| e.eq_ignore_ascii_case("pfm") || e.eq_ignore_ascii_case("exr"))
+    };
+    if given("exposure") && linear(&a.output) {
+        out.push("--exposure is ignored: .exr and .pfm images store linear radiance (it scales PNG output)".into());
     }
     out
 }

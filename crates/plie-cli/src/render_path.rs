@@ -50,6 +50,10 @@ pub fn json_fields(out: &Traced, args: &PathArgs, k: u32) -> Result<serde_json::
         "shadow_rays": s.shadow_rays,
         "occluded": s.occluded,
         "triangle_tests": s.triangle_tests,
+        "lane_tests": s.lane_tests,
+        "box_tests": s.box_tests,
+        "blocker_tests": s.blocker_tests,
+        "own_leaf_tests": s.own_leaf_tests,
         "answers": s.answers,
         "shadow_rays_per_second": s.shadow_rays as f64 / p.shadow_seconds.max(1e-9),
     }))

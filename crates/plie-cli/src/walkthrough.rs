@@ -41,6 +41,10 @@ impl FromStr for FrameRange {
     }
 }
 
+/// Most frames one command renders (and checks before it starts): over 11 hours of film at 24
+/// frames a second; a longer path is rendered in ranges.
+pub const MAX_FRAMES: u64 = 1_000_000;
+
 /// The frames to render and where each goes.
 pub struct Plan {
     path: CameraPath,
@@ -92,6 +96,16 @@ impl Plan {
                 camera_path.display()
             );
         }
+        let count = u64::from(frames.last - frames.first) + 1;
+        if count > MAX_FRAMES {
+            bail!(
+                "--frames {}..{} asks for {count} frames of {}; one command renders at most {MAX_FRAMES} \
+                 (give a smaller --frames range, e.g. one per render-farm task)",
+                frames.first,
+                frames.last,
+                camera_path.display()
+            );
+        }
         let plan = Plan { path, frames, pattern, resume };
         for f in frames.first..=frames.last {
             plan.path.camera(f).with_context(|| format!("{}", camera_path.display()))?;
@@ -103,6 +117,13 @@ impl Plan {
     /// The output file of `frame`.
     pub fn file(&self, frame: u32) -> PathBuf {
         self.pattern.file(frame)
+    }
+
+    /// The output files of the frames to render that exist now (the only ones that can be an
+    /// input of the command), and the first frame's.
+    pub fn existing_files(&self) -> impl Iterator<Item = PathBuf> + '_ {
+        let (a, b) = (self.frames.first, self.frames.last);
+        (a..=b).map(|f| self.file(f)).enumerate().filter(|(n, p)| *n == 0 || p.exists()).map(|(_, p)| p)
     }
 
     /// Renders every frame of the plan with `render` (camera to linear radiance) and writes it with

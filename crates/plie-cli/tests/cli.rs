@@ -151,7 +151,10 @@ fn render_stats_and_json_report_how_shadow_rays_were_answered() {
             assert_eq!(count, path(k), "{mode}: {line}");
             assert!(line.ends_with('%'), "{mode}: {line}");
         }
-        assert!(stats.contains("blockers") && stats.contains("own leaf per shadow ray"), "{mode}: {stats}");
+        assert!(
+            stats.contains("blocker and") && stats.contains("own-leaf triangle tests per shadow ray"),
+            "{mode}: {stats}"
+        );
     }
     // Modes without a P-LIE count no paths: zeros in the JSON, no table.
     assert!(bvh["answers"].as_object().unwrap().values().all(|x| x == 0), "{bvh}");

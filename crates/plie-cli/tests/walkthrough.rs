@@ -158,4 +158,10 @@ fn bad_walkthroughs_are_one_line_errors() {
         run(&["--camera-path", bad.to_str().unwrap(), "-o", out], needle);
     }
     run(&["--camera-path", d.join("missing.json").to_str().unwrap(), "-o", out], "missing.json");
+    // A path of 4,294,967,296 frames: an error at once, not a check of every frame's camera.
+    let long = d.join("long.json");
+    std::fs::write(&long, std::fs::read_to_string(&path).unwrap().replace("\"frame\": 4", "\"frame\": 4294967295"))
+        .unwrap();
+    run(&["--camera-path", long.to_str().unwrap(), "-o", out], "at most 1000000");
+    run(&["--camera-path", long.to_str().unwrap(), "--frames", "5..1000005", "-o", out], "asks for 1000001 frames");
 }

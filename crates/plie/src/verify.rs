@@ -2,8 +2,8 @@
 //! what the file's checksum and the structural checks on load can see (a file altered and
 //! re-checksummed).
 //!
-//! - [`verify_full`] rebuilds the whole P-LIE with the file's parameters (SPEC §4, §4.8 refinement
-//!   included) and compares every table; the first difference is reported by table and record.
+//! - [`verify_full`] rebuilds the whole P-LIE with the file's parameters and limits (SPEC §4, §4.8
+//!   refinement included) and compares every table; the first difference is reported by table and record.
 //! - [`verify_sample`] is the quick check: for a seeded random sample of records it shoots shadow
 //!   rays from points of the record's leaf to points of its light and compares the answers of every
 //!   P-LIE mode (SPEC §5 modes b-d and `grid`) with brute force, the project's definition of exact.
@@ -27,11 +27,11 @@ pub struct Report {
     pub rays: usize,
 }
 
-/// Rebuilds the P-LIE of `scene` with `plie`'s parameters and compares it table by table. Returns
-/// the first difference as an error message.
+/// Rebuilds the P-LIE of `scene` with `plie`'s parameters and limits and compares it table by
+/// table. Returns the first difference as an error message.
 pub fn verify_full(scene: &Scene, plie: &Plie) -> Result<Report, String> {
     let octree = Octree::build(scene, plie.params.octree()).map_err(|e| e.to_string())?;
-    let built = crate::construct::build_bounded(scene, octree, plie.params, Default::default(), &NoProgress)
+    let built = crate::construct::build_bounded(scene, octree, plie.params, plie.limits, &NoProgress)
         .map_err(|e| e.to_string())?
         .plie;
     first_difference(&built, plie)?;
@@ -49,8 +49,12 @@ fn first_difference(rebuilt: &Plie, stored: &Plie) -> Result<(), String> {
             None => Ok(()),
         }
     }
-    if rebuilt.params != stored.params || rebuilt.leaves != stored.leaves || rebuilt.lights != stored.lights {
-        return Err("the header (parameters, leaf or light count) differs from the rebuilt one".into());
+    if rebuilt.params != stored.params
+        || rebuilt.limits != stored.limits
+        || rebuilt.leaves != stored.leaves
+        || rebuilt.lights != stored.lights
+    {
+        return Err("the header (parameters, limits, leaf or light count) differs from the rebuilt one".into());
     }
     table("octree splits", &rebuilt.splits, &stored.splits)?;
     table("record index", &rebuilt.record_index, &stored.record_index)?;

@@ -304,7 +304,10 @@ fn lifting_spends_at_most_its_budget_in_an_order_free_of_threads() {
     let one = rayon::ThreadPoolBuilder::new().num_threads(1).build().unwrap();
     let single = one.install(|| build(&scene, params, limits));
     assert!(single.plie == lifted.plie, "the lifted cap's result depends on the thread count");
-    let none = build(&scene, params, Limits { lift_clips: Some(0), ..Limits::default() });
+    let mut none = build(&scene, params, Limits { lift_clips: Some(0), ..Limits::default() });
+    // The same tables; the P-LIE records the limits it was built within.
+    assert_eq!(none.plie.limits.lift_clips, Some(0));
+    none.plie.limits = capped.plie.limits;
     assert!(none.plie == capped.plie, "a budget of nothing lifts nothing");
 }
 
@@ -397,7 +400,10 @@ fn scene_cells_spend_at_most_their_budget_in_an_order_free_of_threads() {
     let one = rayon::ThreadPoolBuilder::new().num_threads(1).build().unwrap();
     let single = one.install(|| build(&scene, params, limits));
     assert!(single.plie == cells.plie, "the scene cells depend on the thread count");
-    let none = build(&scene, params, Limits { cell_clips: Some(0), ..Limits::default() });
+    let mut none = build(&scene, params, Limits { cell_clips: Some(0), ..Limits::default() });
+    // The same tables; the P-LIE records the limits it was built within.
+    assert_eq!(none.plie.limits.cell_clips, Some(0));
+    none.plie.limits = capped.plie.limits;
     assert!(none.plie == capped.plie, "a budget of nothing gathers no cells");
     assert!(check_exact(&scene, &cells, 10_000) > 100);
 }
@@ -449,4 +455,18 @@ fn a_cancelled_construction_returns_interrupted() {
         );
         assert_eq!(r.err(), Some(Interrupted), "after {after}");
     }
+}
+
+/// `--blocker-cap 0`: every record with a blocker stays with the scene BVH; the lift has nothing to
+/// lift (a cap of 16 times nothing), the cells still gather, and every mode stays exact.
+#[test]
+fn a_blocker_cap_of_zero_lifts_nothing_and_stays_exact() {
+    let scene = balusters();
+    let params = PlieParams { blocker_cap: Some(0), ..PlieParams::default() };
+    let n = scene.triangle_count();
+    let limits = Limits { lift_clips: Some(16 * n), cell_clips: Some(64 * n), ..Limits::default() };
+    let built = build(&scene, params, limits);
+    let b = &built.stats.bounded;
+    assert!(b.records_scene > 0 && b.records_lifted == 0 && b.records_lift_tried == 0, "{b:?}");
+    assert!(check_exact(&scene, &built, 10_000) > 100);
 }

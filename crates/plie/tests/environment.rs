@@ -21,8 +21,15 @@ fn build_includes_refinement_and_equals_the_stages() {
     let params = PlieParams { refine: RefineParams::thesis_umbra(), ..PlieParams::default() };
     let (env, stats) = Environment::build(&scene, &params).unwrap();
     let octree = Octree::build(&scene, params.octree()).unwrap();
-    let built =
-        plie::internals::construct::build_bounded(&scene, octree, params, Default::default(), &NoProgress).unwrap();
+    // `Environment::build`'s limits: the default clip budgets per triangle, no list budget.
+    let n = scene.triangles.len();
+    let limits = plie::internals::construct::Limits {
+        list_bytes: None,
+        lift_clips: Some(plie::DEFAULT_LIFT_CLIPS * n),
+        cell_clips: Some(plie::DEFAULT_CELL_CLIPS * n),
+    };
+    assert_eq!(env.plie().limits, limits, "the P-LIE records the limits it was built within");
+    let built = plie::internals::construct::build_bounded(&scene, octree, params, limits, &NoProgress).unwrap();
     assert!(stats.refinement.rounds > 0, "cornell-cube-4 refines by umbra");
     assert_eq!(env.plie(), &built.plie);
     assert_eq!(env.octree(), &built.octree);

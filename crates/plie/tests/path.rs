@@ -20,13 +20,13 @@ struct PathRendered {
 
 /// A closed unit cube, every face an inward-facing light of radiance `le` and albedo `rho`.
 fn furnace(rho: f32, le: f32) -> Scene {
+    furnace_rgb(rho, Vec3::splat(le))
+}
+
+/// [`furnace`] with radiance `le` per channel.
+fn furnace_rgb(rho: f32, le: Vec3) -> Scene {
     let mut b = SceneBuilder::new("furnace");
-    let m = b.material(Material {
-        name: "wall".into(),
-        albedo: Vec3::splat(rho),
-        emission: Vec3::splat(le),
-        texture: None,
-    });
+    let m = b.material(Material { name: "wall".into(), albedo: Vec3::splat(rho), emission: le, texture: None });
     let c = |x: f32, y: f32, z: f32| Vec3::new(x, y, z);
     // Each face counter-clockwise seen from inside the cube (so its front faces inward).
     let faces = [
@@ -40,7 +40,7 @@ fn furnace(rho: f32, le: f32) -> Scene {
     for f in faces {
         let first = b.triangle_count() as u32;
         b.quad(f[0], f[1], f[2], f[3], m);
-        b.light_from_triangles(vec![TriId(first), TriId(first + 1)], f.to_vec(), Vec3::splat(le));
+        b.light_from_triangles(vec![TriId(first), TriId(first + 1)], f.to_vec(), le);
     }
     b.build().unwrap()
 }
@@ -136,4 +136,24 @@ fn exact_modes_give_bit_identical_path_images_for_any_thread_count() {
             assert_eq!(out.path.locates > 0, mode.needs_plie(), "{mode}");
         }
     }
+}
+
+/// Lights whose power is below f32's range (radiance 1e-45, the least subnormal, in one channel:
+/// a third of it rounds to zero) still give finite pixels when lights are chosen by power; a light
+/// whose power is beyond f32's range is refused.
+#[test]
+fn faint_lights_give_finite_pixels_and_overflowing_ones_are_refused() {
+    let scene = furnace_rgb(0.5, Vec3::new(1e-45, 0.0, 0.0));
+    for nee in [Nee::Power, Nee::All] {
+        let path = PathSettings { spp: 4, max_depth: 3, rr_depth: None, nee };
+        let out = trace(&scene, &inside_camera(), 8, 2, path, Mode::Bvh);
+        assert!(out.pixels.iter().all(|p| p.is_finite()), "{nee:?}: a pixel is not finite");
+    }
+    let mut b = SceneBuilder::new("bright");
+    let c = |x: f32, z: f32| Vec3::new(x, 1.0, z);
+    b.light("sun", &[c(0.0, 0.0), c(0.0, 2.0), c(2.0, 2.0), c(2.0, 0.0)], Vec3::splat(3e38));
+    let w = b.diffuse("w", Vec3::splat(0.5));
+    b.quad(Vec3::ZERO, Vec3::Z, Vec3::new(1.0, 0.0, 1.0), Vec3::X, w);
+    let err = b.build().unwrap_err().to_string();
+    assert!(err.contains("beyond the range of f32"), "{err}");
 }

@@ -9,7 +9,9 @@ use super::round::{Round, TaskRecords};
 use super::scene_cells::Cells;
 use super::stats::{BuildStats, RoundStats};
 use super::{grid, Built};
-use crate::lie::{FaceGrid, Plie, PlieParams, Record, RecordKind, RecordRegions, NO_RECORD, SCENE_CELL, UMBRA_CELL};
+use crate::lie::{
+    FaceGrid, Limits, Plie, PlieParams, Record, RecordKind, RecordRegions, NO_RECORD, SCENE_CELL, UMBRA_CELL,
+};
 use crate::octree::{Dir, Octree};
 use crate::scene::{LightId, Scene, TriId};
 
@@ -51,6 +53,7 @@ pub(super) fn finish(
     let mut stats = BuildStats::default();
     stats.octree.leaves = octree.leaf_count();
     stats.octree.depth = octree.depth();
+    stats.octree.capped = octree.capped;
     stats.blockers.faces_considered = octree.leaf_count() * 6 * lights;
     stats.bounded.blocker_cap = params.blocker_cap;
     stats.bounded.records_over_budget = over_budget;
@@ -67,6 +70,7 @@ pub(super) fn finish(
     r.rounds = refiner.splits.len();
     r.leaves_added = 7 * refiner.by_criterion.values().sum::<usize>();
     r.splits_by_criterion = refiner.by_criterion;
+    r.stopped_at_node_cap = refiner.capped;
     r.unrefined = totals.unrefined;
     stats.grids.enabled = params.has_grids();
     let mut plie = flatten(&octree, params, lights, tasks, &mut stats);
@@ -107,6 +111,7 @@ pub(super) fn flatten(
         regions: Vec::new(),
         region_tris: Vec::new(),
         splits: Vec::new(),
+        limits: Limits::default(),
     };
     let (mut task_seconds, mut computed) = (0.0, 0);
     for t in &tasks {

@@ -70,6 +70,10 @@ pub(super) fn lift_caps(
     lift: &mut Lift,
 ) -> Result<(), Interrupted> {
     let (Some(cap), Some(_)) = (params.blocker_cap, lift.clips_left) else { return Ok(()) };
+    if cap == 0 {
+        // A cap of nothing lifted is still nothing: every record with a blocker stays a scene record.
+        return Ok(());
+    }
     let lights = scene.lights.len();
     let capped = in_lift_order(round, octree, lights, |r| r.liftable);
     let task = |t: usize| task_of(t, lights);

@@ -39,6 +39,7 @@ mod stats;
 
 use std::time::Instant;
 
+pub use crate::lie::Limits;
 use crate::lie::{Plie, PlieParams};
 use crate::octree::Octree;
 use crate::progress::Progress;
@@ -66,26 +67,6 @@ pub fn tolerance(scene: &Scene, octree: &Octree) -> f32 {
 /// regions and propagation allow for.
 pub(crate) fn abs_scale(octree: &Octree) -> f32 {
     octree.root_bounds().min.abs().max(octree.root_bounds().max.abs()).max_element()
-}
-
-/// Limits of one construction that are not part of the P-LIE's parameters (issue 15).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub struct Limits {
-    /// Bytes the blocker lists of the records and grid cells may take. A listed record that would
-    /// pass it is stored as [`crate::lie::RecordKind::Scene`] instead (degrading, never aborting); the decision is
-    /// made at the record's commit, in task order, so it does not depend on the thread count. `None`:
-    /// no limit.
-    pub list_bytes: Option<usize>,
-    /// Candidate clips the construction may spend gathering the records over the blocker cap again
-    /// with a cap up to [`lift::LIFT_FACTOR`] times larger ([`lift`]); in a fixed order, so the result
-    /// does not depend on the thread count. `None`: no lifting (every record over the cap stays a
-    /// scene record).
-    pub lift_clips: Option<usize>,
-    /// Candidate clips the construction may spend gathering the cells of the records still over the
-    /// cap after the lift, each cell with a small cap ([`scene_cells`]); in a fixed order, so the
-    /// result does not depend on the thread count. `None`: none (their cells outside the umbra stay
-    /// answered by the scene BVH).
-    pub cell_clips: Option<usize>,
 }
 
 /// The construction was interrupted ([`Progress::cancelled`]); nothing was built.
@@ -150,5 +131,7 @@ pub fn build_bounded(
         prior = Some(Prior { round, origin });
         octree = refined;
     };
-    Ok(flatten::finish(scene, octree, params, round, refiner, totals, t0))
+    let mut built = flatten::finish(scene, octree, params, round, refiner, totals, t0);
+    built.plie.limits = limits;
+    Ok(built)
 }

@@ -123,12 +123,19 @@ pub(super) struct Refiner {
     pub(super) splits: Vec<Vec<u32>>,
     /// Leaves split, by the criterion that asked.
     pub(super) by_criterion: BTreeMap<&'static str, usize>,
+    /// True if refinement ended at the octree's node cap ([`crate::octree::max_nodes`]).
+    pub(super) capped: bool,
 }
 
 impl Refiner {
     /// Nothing split yet on `octree`.
     pub(super) fn new(octree: &Octree) -> Refiner {
-        Refiner { level: vec![0; octree.leaf_count()], splits: Vec::new(), by_criterion: BTreeMap::new() }
+        Refiner {
+            level: vec![0; octree.leaf_count()],
+            splits: Vec::new(),
+            by_criterion: BTreeMap::new(),
+            capped: false,
+        }
     }
 
     /// The progress stage name of the next round.
@@ -162,6 +169,11 @@ impl Refiner {
             .collect();
         let split: Vec<LeafId> =
             candidates.iter().zip(&decisions).filter(|(_, d)| d.is_some()).map(|(&l, _)| l).collect();
+        // Refinement ends before the octree would pass its node cap.
+        if octree.node_count() + 8 * split.len() > crate::octree::max_nodes(triangles) {
+            self.capped = true;
+            return Vec::new();
+        }
         if !split.is_empty() {
             for d in decisions.iter().flatten() {
                 *self.by_criterion.entry(d.name()).or_default() += 1;

@@ -42,6 +42,8 @@ pub struct OctreeStats {
     pub depth: u32,
     /// Seconds building the octree (before refinement).
     pub octree_seconds: f64,
+    /// True if the node cap ([`crate::octree::max_nodes`]) kept the build from splitting a level.
+    pub capped: bool,
 }
 
 /// Which (leaf, face, light) get a record, and their blockers.
@@ -157,6 +159,9 @@ pub struct RefinementStats {
     pub splits_by_criterion: BTreeMap<&'static str, usize>,
     /// Leaves added by the splits.
     pub leaves_added: usize,
+    /// True if refinement ended because the next round's splits would pass the octree's node cap
+    /// ([`crate::octree::max_nodes`]).
+    pub stopped_at_node_cap: bool,
     /// With refinement: the first round's figures, i.e. the P-LIE without refinement.
     pub unrefined: Option<RoundStats>,
 }
@@ -197,7 +202,9 @@ impl fmt::Display for BuildStats {
     /// scene and the file).
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         let o = &self.octree;
-        writeln!(f, "octree          {} leaves, depth {} ({:.3} s)", o.leaves, o.depth, o.octree_seconds)?;
+        let capped =
+            if o.capped { "; the node cap stopped its splits, raise --max-triangles or lower --max-depth" } else { "" };
+        writeln!(f, "octree          {} leaves, depth {} ({:.3} s{capped})", o.leaves, o.depth, o.octree_seconds)?;
         write!(f, "{}{}{}", self.blockers, self.bounded, self.regions)?;
         // Propagation needs regions: without them it says nothing.
         if self.regions.regions {
@@ -232,10 +239,10 @@ impl fmt::Display for BlockerStats {
 impl fmt::Display for BoundedStats {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         let cap = self.blocker_cap.map_or("no cap".to_string(), |c| c.to_string());
-        let budget = self.list_budget.map_or("no".to_string(), |b| format!("{b} bytes of"));
+        let budget = self.list_budget.map_or("no".to_string(), |b| format!("{b}-byte"));
         writeln!(
             f,
-            "scene records   {} answered by the scene BVH ({} with more than {cap} blockers, {} over the budget of {budget} blocker lists)",
+            "scene records   {} answered by the scene BVH ({} with more than {cap} blockers, {} over the {budget} budget of the blocker lists)",
             self.records_scene,
             self.records_scene - self.records_over_budget,
             self.records_over_budget
@@ -244,8 +251,8 @@ impl fmt::Display for BoundedStats {
             None => writeln!(f, "lifted cap      none"),
             Some(b) => writeln!(
                 f,
-                "lifted cap      {} of {} records over the cap gathered again hold their full lists ({b} clips per triangle)",
-                self.records_lifted, self.records_lift_tried
+                "lifted cap      {} records over the cap gathered again with a larger cap, {} of them now hold their full lists ({b} clips per triangle)",
+                self.records_lift_tried, self.records_lifted
             ),
         }?;
         match self.cell_clips {
@@ -315,13 +322,18 @@ impl fmt::Display for RefinementText<'_> {
             return writeln!(f, "refinement      none (--refine to enable)");
         };
         let by: Vec<String> =
-            r.splits_by_criterion.iter().map(|(c, n)| format!("{c} {n} splits (+{} leaves)", 7 * n)).collect();
+            // The criteria as `--refine` spells them (`umbra-free`; the JSON keys keep `umbra_free`).
+            r.splits_by_criterion
+                .iter()
+                .map(|(c, n)| format!("{} {n} splits (+{} leaves)", c.replace('_', "-"), 7 * n))
+                .collect();
         writeln!(
             f,
-            "refinement      +{} leaves in {} rounds (max split depth {}){}{}",
+            "refinement      +{} leaves in {} rounds (max split depth {}{}){}{}",
             r.leaves_added,
             r.rounds,
             r.max_split_depth,
+            if r.stopped_at_node_cap { "; stopped at the octree's node cap" } else { "" },
             if by.is_empty() { "" } else { ": " },
             by.join(", ")
         )?;

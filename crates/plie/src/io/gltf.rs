@@ -19,7 +19,8 @@
 //! type, count, stride and byte range within its buffer view and buffer. Sparse accessors, quantized
 //! (non-float) positions and point/line primitives are rejected with a clear error.
 
-use std::path::Path;
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
 
 use ::gltf::accessor::{DataType, Dimensions};
 use ::gltf::mesh::Mode;
@@ -28,10 +29,10 @@ use glam::{Mat4, Vec2, Vec3};
 
 use super::input::{read_bounded, resolve_in_scene, short, LoadOptions, MAX_INPUT_BYTES};
 use super::lights::{self, EmissiveTriangle};
-use super::texture_file::decode_texture;
+use super::texture_file::TextureFiles;
 use super::{material_warnings, parse_error, scene_name};
 use crate::error::{Error, Result, SceneElement};
-use crate::scene::texture::{Filter, Wrap};
+use crate::scene::texture::{Filter, Texture, Wrap};
 use crate::scene::{Camera, Material, MaterialId, Scene, SceneBuilder};
 
 /// Loads a `.gltf` or `.glb` file (see the module doc); buffers only from the file's folder.
@@ -51,12 +52,17 @@ pub fn load_gltf_with(path: &Path, opts: LoadOptions) -> Result<Scene> {
     check_primitive_indices(path, raw.document.as_json())?;
     let document = ::gltf::Document::from_json(raw.document.into_json()).map_err(|e| gltf_error(path, e))?;
     let gltf = ::gltf::Gltf { document, blob: raw.blob };
-    let buffers = load_buffers(path, &gltf.document, gltf.blob.clone(), opts)?;
+    let (buffers, buffer_files) = load_buffers(path, &gltf.document, gltf.blob.clone(), opts)?;
     let doc = &gltf.document;
     let scene =
         doc.default_scene().or_else(|| doc.scenes().next()).ok_or_else(|| bad("the file has no scene".into()))?;
+    let mut builder = SceneBuilder::new(&scene_name(path));
+    builder.source(path);
+    for f in &buffer_files {
+        builder.source(f);
+    }
     let mut loader = Loader {
-        builder: SceneBuilder::new(&scene_name(path)),
+        builder,
         buffers: &buffers,
         dir: path.parent().unwrap_or(Path::new("")),
         opts,
@@ -66,6 +72,8 @@ pub fn load_gltf_with(path: &Path, opts: LoadOptions) -> Result<Scene> {
         emissive_info: Vec::new(),
         camera: None,
         ignored: Vec::new(),
+        texture_files: TextureFiles::default(),
+        images: HashMap::new(),
     };
     let mut seen = vec![false; doc.nodes().len()];
     let mut stack: Vec<(::gltf::Node, Mat4)> = scene.nodes().map(|n| (n, Mat4::IDENTITY)).collect();
@@ -160,15 +168,17 @@ fn check_glb_header(bytes: &[u8]) -> Result<(), String> {
     Ok(())
 }
 
-/// Reads every buffer (GLB chunk, data URI or external file), naming the buffer that fails.
+/// Reads every buffer (GLB chunk, data URI or external file), naming the buffer that fails; the
+/// buffers and the external files read.
 fn load_buffers(
     path: &Path,
     doc: &Document,
     mut blob: Option<Vec<u8>>,
     opts: LoadOptions,
-) -> Result<Vec<::gltf::buffer::Data>> {
+) -> Result<(Vec<::gltf::buffer::Data>, Vec<PathBuf>)> {
     let base = path.parent().unwrap_or(Path::new("."));
     let mut out = Vec::new();
+    let mut files = Vec::new();
     for buffer in doc.buffers() {
         let what = match buffer.source() {
             ::gltf::buffer::Source::Uri(uri) if uri.starts_with("data:") => {
@@ -193,6 +203,7 @@ fn load_buffers(
                     Error::Io { source, .. } => parse_error(path, None, format!("cannot load {what}: {source}")),
                     e => parse_error(path, None, format!("cannot load {what}: {e}")),
                 })?;
+                files.push(file);
                 ::gltf::buffer::Data(bytes)
             }
             source => ::gltf::buffer::Data::from_source_and_blob(source, Some(base), &mut blob).map_err(|e| {
@@ -209,7 +220,7 @@ fn load_buffers(
         }
         out.push(data);
     }
-    Ok(out)
+    Ok((out, files))
 }
 
 /// Checks that the `gltf` crate can read `acc` safely: not sparse, count >= 1, a type `ok` accepts, a
@@ -268,6 +279,10 @@ struct Loader<'a> {
     camera: Option<Camera>,
     /// Material features read but not rendered: (what, material) ([`Scene::warnings`]).
     ignored: Vec<(String, String)>,
+    /// Image files decoded (each once) and the budget of texels.
+    texture_files: TextureFiles,
+    /// The decoded image of each glTF image index used so far (materials share them).
+    images: HashMap<usize, Texture>,
 }
 
 impl Loader<'_> {
@@ -377,32 +392,16 @@ impl Loader<'_> {
 
     /// Decodes a texture's image (sRGB) with its sampler's wrap modes and filter.
     fn texture(&mut self, t: ::gltf::Texture) -> Result<crate::scene::TextureId, String> {
-        use ::gltf::image::Source;
         use ::gltf::texture::{MagFilter, WrappingMode};
         let image = t.source();
-        let what = format!("image {}", image.index());
-        let (name, bytes) = match image.source() {
-            Source::View { view, .. } => {
-                let data = self.buffers.get(view.buffer().index()).map(|d| &d.0[..]).unwrap_or(&[]);
-                let end = view.offset().checked_add(view.length()).filter(|&e| e <= data.len());
-                let end = end.ok_or_else(|| format!("{what}: bufferView {} reads past its buffer", view.index()))?;
-                (what.clone(), data[view.offset()..end].to_vec())
-            }
-            Source::Uri { uri, .. } if uri.starts_with("data:") => {
-                let b64 = uri
-                    .split_once(";base64,")
-                    .map(|(_, d)| d)
-                    .ok_or_else(|| format!("{what}: a data URI without base64"))?;
-                (what.clone(), base64::decode(b64).map_err(|_| format!("{what}: the data URI is not valid base64"))?)
-            }
-            Source::Uri { uri, .. } => {
-                let decoded = urlencoding::decode(uri).map_err(|_| format!("{what}: the URI is not UTF-8"))?;
-                let file = resolve_in_scene(self.dir, &decoded, &format!("{what} URI"), self.opts)?;
-                let bytes = read_bounded(&file, MAX_INPUT_BYTES).map_err(|e| format!("{what}: {e}"))?;
-                (short(&decoded), bytes)
+        let mut tex = match self.images.get(&image.index()) {
+            Some(tex) => tex.clone(),
+            None => {
+                let tex = self.image(&image)?;
+                self.images.insert(image.index(), tex.clone());
+                tex
             }
         };
-        let mut tex = decode_texture(&name, bytes, true).map_err(|e| format!("{what}: {e}"))?;
         let sampler = t.sampler();
         let wrap = |w: WrappingMode| match w {
             WrappingMode::Repeat => Wrap::Repeat,
@@ -412,6 +411,35 @@ impl Loader<'_> {
         tex.wrap = [wrap(sampler.wrap_s()), wrap(sampler.wrap_t())];
         tex.filter = if sampler.mag_filter() == Some(MagFilter::Nearest) { Filter::Nearest } else { Filter::Bilinear };
         Ok(self.builder.texture(tex))
+    }
+
+    /// Decodes an image (sRGB): from a buffer view, a data URI or a file of the scene's folder.
+    fn image(&mut self, image: &::gltf::Image) -> Result<Texture, String> {
+        use ::gltf::image::Source;
+        let what = format!("image {}", image.index());
+        let bytes = match image.source() {
+            Source::View { view, .. } => {
+                let data = self.buffers.get(view.buffer().index()).map(|d| &d.0[..]).unwrap_or(&[]);
+                let end = view.offset().checked_add(view.length()).filter(|&e| e <= data.len());
+                let end = end.ok_or_else(|| format!("{what}: bufferView {} reads past its buffer", view.index()))?;
+                data[view.offset()..end].to_vec()
+            }
+            Source::Uri { uri, .. } if uri.starts_with("data:") => {
+                let b64 = uri
+                    .split_once(";base64,")
+                    .map(|(_, d)| d)
+                    .ok_or_else(|| format!("{what}: a data URI without base64"))?;
+                base64::decode(b64).map_err(|_| format!("{what}: the data URI is not valid base64"))?
+            }
+            Source::Uri { uri, .. } => {
+                let decoded = urlencoding::decode(uri).map_err(|_| format!("{what}: the URI is not UTF-8"))?;
+                let file = resolve_in_scene(self.dir, &decoded, &format!("{what} URI"), self.opts)?;
+                let tex = self.texture_files.load(&file, true).map_err(|e| format!("{what}: {e}"))?;
+                self.builder.source(&file);
+                return Ok(Texture { name: short(&decoded), ..tex });
+            }
+        };
+        self.texture_files.decode(&what, bytes, true).map_err(|e| format!("{what}: {e}"))
     }
 
     /// The primitive's texture coordinates for its material's base colour texture, if it has them.

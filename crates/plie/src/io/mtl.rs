@@ -32,6 +32,8 @@ pub(super) struct Libraries {
     pub(super) ignored: Vec<(String, String)>,
     /// `map_Kd` textures: (material, file), the file resolved inside the scene's folder.
     pub(super) textures: Vec<(String, PathBuf)>,
+    /// The material library files read, in order ([`crate::Scene::sources`]).
+    pub(super) files: Vec<PathBuf>,
     /// How files named in the MTL files are confined.
     pub(super) opts: LoadOptions,
 }
@@ -153,6 +155,7 @@ fn load_library(obj: &Path, file: &Path, libs: &RefCell<Libraries>) -> tobj::MTL
     let line = libs.borrow().line;
     let f = open_regular(file, MAX_INPUT_BYTES)
         .map_err(|e| fail(parse_error(obj, Some(line), format!("mtllib: cannot open material library {e}"))))?;
+    libs.borrow_mut().files.push(file.to_path_buf());
     let dir = file.parent().unwrap_or(Path::new("")).to_path_buf();
     let mut reader = LineFilter::new(BufReader::new(f), MtlRules { libs, dir, material: String::new() });
     let result = tobj::load_mtl_buf(&mut reader);

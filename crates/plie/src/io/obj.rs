@@ -25,7 +25,7 @@ use std::cell::RefCell;
 use std::collections::HashMap;
 use std::fmt::Write as _;
 use std::io::BufReader;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::str::SplitWhitespace;
 
 use glam::{Vec2, Vec3};
@@ -34,11 +34,11 @@ use super::input::{open_regular, short, LoadOptions, MAX_INPUT_BYTES};
 use super::lights::{self, EmissiveTriangle};
 use super::mtl::{load_libraries, material, Libraries};
 use super::obj_lines::{parse_finite, rest_after_keyword, strip_comment, LineFilter, LineRules};
-use super::texture_file::load_texture;
+use super::texture_file::TextureFiles;
 use super::tri_mesh::TriMesh;
 use super::{material_warnings, parse_error, scene_name};
 use crate::error::{Error, Result};
-use crate::scene::{Material, MaterialId, Scene, SceneBuilder};
+use crate::scene::{Material, MaterialId, Scene, SceneBuilder, TextureId};
 
 /// Loads an OBJ file and the MTL files it names (see the module doc), the MTL files only from the
 /// OBJ's folder.
@@ -65,11 +65,9 @@ pub fn load_obj_with(path: &Path, opts: LoadOptions) -> Result<Scene> {
     if reader.line() == 0 {
         return Err(parse_error(path, None, "the file is empty".into()));
     }
-    let has_mtllib = !libs.borrow().names.is_empty() || !libs.borrow().libs.is_empty();
-    let textures = std::mem::take(&mut libs.borrow_mut().textures);
-    let mut ignored = std::mem::take(&mut libs.borrow_mut().ignored);
-    let mut scene = build(path, &models, &materials, &reader.rules.tri_lines, has_mtllib, &textures, &mut ignored)?;
-    scene.warnings = material_warnings(&ignored);
+    let mut libs = libs.borrow_mut();
+    let mut scene = build(path, &models, &materials, &reader.rules.tri_lines, &mut libs)?;
+    scene.warnings = material_warnings(&libs.ignored);
     Ok(scene)
 }
 
@@ -279,21 +277,36 @@ impl LineRules for ObjRules<'_> {
     }
 }
 
-/// Builds the scene from `tobj`'s meshes; `tri_lines` is the OBJ line of every triangle, in order.
+/// Builds the scene from `tobj`'s meshes; `tri_lines` is the OBJ line of every triangle, in order;
+/// `libs` what the material libraries gave (textures are loaded here, each file once).
 fn build(
     path: &Path,
     models: &[tobj::Model],
     materials: &[tobj::Material],
     tri_lines: &[u32],
-    has_mtllib: bool,
-    textures: &[(String, PathBuf)],
-    ignored: &mut Vec<(String, String)>,
+    libs: &mut Libraries,
 ) -> Result<Scene> {
+    let has_mtllib = !libs.names.is_empty() || !libs.libs.is_empty();
+    let ignored = &mut libs.ignored;
     let mut b = SceneBuilder::new(&scene_name(path));
-    let mut loaded: HashMap<&str, crate::scene::TextureId> = HashMap::new();
-    for (material, file) in textures {
-        let t = load_texture(file, true)?;
-        loaded.insert(material.as_str(), b.texture(t));
+    b.source(path);
+    for f in &libs.files {
+        b.source(f);
+    }
+    let mut files = TextureFiles::default();
+    let mut by_file: HashMap<&Path, TextureId> = HashMap::new();
+    let mut loaded: HashMap<&str, TextureId> = HashMap::new();
+    for (material, file) in &libs.textures {
+        let id = match by_file.get(file.as_path()) {
+            Some(&id) => id,
+            None => {
+                let id = b.texture(files.load(file, true)?);
+                b.source(file);
+                by_file.insert(file, id);
+                id
+            }
+        };
+        loaded.insert(material.as_str(), id);
     }
     let mut ids: HashMap<Option<usize>, (MaterialId, Material)> = HashMap::new();
     let mut emissive = Vec::new();

@@ -10,8 +10,10 @@
 //! | 8 | XXH3-64 checksum of the payload |
 //! | n | payload: [`FileBody`] in postcard encoding |
 //!
-//! The payload holds the build parameters, a fingerprint of the scene's geometry, materials and lights,
-//! a fingerprint of the octree the P-LIE was built on, and the P-LIE. The octree itself is not stored:
+//! The payload holds the build parameters (the P-LIE holds them too, with the limits it was built
+//! within, so that `plie verify --full` rebuilds it exactly), a fingerprint of the scene's geometry,
+//! materials and lights, a fingerprint of the octree the P-LIE was built on, and the P-LIE. The
+//! octree itself is not stored:
 //! it is a deterministic function of the scene and the parameters, and is rebuilt on load (a fraction
 //! of the P-LIE's build time), then refined by replaying the P-LIE's list of split nodes (SPEC §4.8);
 //! its fingerprint proves it is the same one. Every way a file can be wrong
@@ -32,7 +34,7 @@ use crate::scene::Scene;
 /// First bytes of every `.plie` file.
 pub const MAGIC: [u8; 8] = *b"PLIE\r\n\x1a\n";
 /// Version of the layout written by this build of plie.
-pub const FORMAT_VERSION: u32 = 5;
+pub const FORMAT_VERSION: u32 = 6;
 const HEADER: usize = 8 + 4 + 8 + 8;
 
 /// What a `.plie` file holds after its header.

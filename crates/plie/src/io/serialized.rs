@@ -4,9 +4,16 @@
 //! (`0x0001` vertex normals, `0x0002` texture coordinates, `0x0008` vertex colours, `0x1000` single,
 //! `0x2000` double precision), in version 4 a NUL-terminated name, `u64` vertex and triangle counts, the
 //! positions, normals, texture coordinates and colours, and the indices (`u32`, or `u64` above 2^32
-//! vertices). The file ends with the byte offset of every mesh (`u64` in version 4, `u32` in version
-//! 3) and their number (`u32`). All little-endian. Counts are bounded and data is decompressed only as
-//! far as it is there, so a hostile file cannot make the reader allocate without bound.
+//! vertices, which is over plie's limit). The file ends with the byte offset of every mesh (`u64` in
+//! version 4, `u32` in version 3) and their number (`u32`). All little-endian.
+//!
+//! A zlib stream expands up to about 1,000 times, so a small file can declare and hold a huge mesh
+//! (a 195 KB file of 2^24 triangles, a 3 MB file of 2^28). The counts are checked against the limits
+//! ([`Limits`]: by default the Mitsuba scene's [`MAX_TRIANGLES`] and three vertices a triangle) as
+//! soon as they are read, before anything is allocated or decompressed; the data is then decompressed
+//! a chunk at a time into arrays that grow only as far as the data is there (with `try_reserve`, so a
+//! failed allocation is an error, not an abort). Memory stays proportional to what the limits allow:
+//! at most about 12 bytes a vertex (20 with texture coordinates) and 12 a triangle, plus one chunk.
 
 use std::io::Read;
 use std::path::Path;
@@ -15,22 +22,50 @@ use flate2::read::ZlibDecoder;
 use glam::{Vec2, Vec3};
 
 use super::input::{read_bounded, MAX_INPUT_BYTES};
+use super::mitsuba::MAX_TRIANGLES;
 use super::parse_error;
 use super::tri_mesh::TriMesh;
 use crate::error::Result;
 
 const MAGIC: u16 = 0x041C;
-/// The most vertices or triangles of one mesh plie reads.
-pub const MAX_COUNT: u64 = 1 << 28;
+/// The most bytes decompressed at a time.
+const CHUNK_BYTES: usize = 1 << 20;
 
-/// Reads mesh number `index` of the serialized file at `path`.
-pub fn load_serialized(path: &Path, index: usize) -> Result<TriMesh> {
-    let bytes = read_bounded(path, MAX_INPUT_BYTES)?;
-    parse_serialized(&bytes, index).map_err(|m| parse_error(path, None, m))
+/// The most vertices and triangles a mesh may have.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Limits {
+    /// The most vertices.
+    pub vertices: u64,
+    /// The most triangles.
+    pub triangles: u64,
 }
 
-/// Parses mesh number `index` of a serialized file.
+impl Default for Limits {
+    /// A Mitsuba scene's whole budget: [`MAX_TRIANGLES`] triangles and three times as many vertices
+    /// (more vertices than three a triangle cannot all be used).
+    fn default() -> Self {
+        Limits { vertices: 3 * MAX_TRIANGLES as u64, triangles: MAX_TRIANGLES as u64 }
+    }
+}
+
+/// Reads mesh number `index` of the serialized file at `path`, within the default [`Limits`].
+pub fn load_serialized(path: &Path, index: usize) -> Result<TriMesh> {
+    load_serialized_within(path, index, Limits::default())
+}
+
+/// [`load_serialized`] within `limits` (what a scene has left of its budget).
+pub fn load_serialized_within(path: &Path, index: usize, limits: Limits) -> Result<TriMesh> {
+    let bytes = read_bounded(path, MAX_INPUT_BYTES)?;
+    parse_serialized_within(&bytes, index, limits).map_err(|m| parse_error(path, None, m))
+}
+
+/// Parses mesh number `index` of a serialized file, within the default [`Limits`].
 pub fn parse_serialized(bytes: &[u8], index: usize) -> std::result::Result<TriMesh, String> {
+    parse_serialized_within(bytes, index, Limits::default())
+}
+
+/// [`parse_serialized`] within `limits`.
+pub fn parse_serialized_within(bytes: &[u8], index: usize, limits: Limits) -> std::result::Result<TriMesh, String> {
     let start = if index == 0 { 0 } else { offset(bytes, index)? };
     let head = bytes.get(start..start + 4).ok_or("the file is too short for a mesh header")?;
     let magic = u16::from_le_bytes([head[0], head[1]]);
@@ -41,12 +76,11 @@ pub fn parse_serialized(bytes: &[u8], index: usize) -> std::result::Result<TriMe
     if version != 3 && version != 4 {
         return Err(format!("serialized format version {version} is not supported (3 and 4 are)"));
     }
-    let mut z = ZlibDecoder::new(&bytes[start + 4..]);
-    let mut r = Reader { z: &mut z };
+    let mut r = Reader { z: ZlibDecoder::new(&bytes[start + 4..]) };
     let flags = r.u32()?;
     if version == 4 {
         let mut n = 0;
-        while r.bytes(1)?[0] != 0 {
+        while r.u8()? != 0 {
             n += 1;
             if n > 4096 {
                 return Err("the mesh name is longer than 4096 bytes".into());
@@ -54,51 +88,74 @@ pub fn parse_serialized(bytes: &[u8], index: usize) -> std::result::Result<TriMe
         }
     }
     let (nv, nt) = (r.u64()?, r.u64()?);
-    if nv > MAX_COUNT || nt > MAX_COUNT {
-        return Err(format!("{nv} vertices and {nt} triangles: more than the limit of {MAX_COUNT}"));
+    // Before anything is allocated or decompressed.
+    if nt > limits.triangles {
+        return Err(format!(
+            "the mesh declares {nt} triangles: more than the {} plie reads (a scene holds at most {MAX_TRIANGLES})",
+            limits.triangles
+        ));
     }
-    let double = flags & 0x2000 != 0;
-    let real = if double { 8 } else { 4 };
-    let floats = |r: &mut Reader, n: u64| -> std::result::Result<Vec<f32>, String> {
-        let b = r.bytes(n as usize * real)?;
-        Ok(if double {
-            b.chunks_exact(8).map(|c| f64::from_le_bytes(c.try_into().unwrap_or([0; 8])) as f32).collect()
-        } else {
-            b.chunks_exact(4).map(|c| f32::from_le_bytes(c.try_into().unwrap_or([0; 4]))).collect()
-        })
-    };
-    let p = floats(&mut r, 3 * nv)?;
-    let positions: Vec<Vec3> = p.chunks_exact(3).map(|c| Vec3::new(c[0], c[1], c[2])).collect();
-    if let Some(i) = positions.iter().position(|v| !v.is_finite()) {
-        return Err(format!("vertex {i} is not finite"));
-    }
-    if flags & 0x0001 != 0 {
-        floats(&mut r, 3 * nv)?;
-    }
-    let uvs = if flags & 0x0002 != 0 {
-        let t = floats(&mut r, 2 * nv)?;
-        t.chunks_exact(2).map(|c| Vec2::new(c[0], c[1])).collect()
-    } else {
-        Vec::new()
-    };
-    if flags & 0x0008 != 0 {
-        floats(&mut r, 3 * nv)?;
-    }
-    let wide = nv > u32::MAX as u64;
-    let b = r.bytes(3 * nt as usize * if wide { 8 } else { 4 })?;
-    let idx: Vec<u64> = if wide {
-        b.chunks_exact(8).map(|c| u64::from_le_bytes(c.try_into().unwrap_or([0; 8]))).collect()
-    } else {
-        b.chunks_exact(4).map(|c| u32::from_le_bytes(c.try_into().unwrap_or([0; 4])) as u64).collect()
-    };
-    if let Some(i) = idx.iter().find(|&&i| i >= nv) {
-        return Err(format!("triangle index {i} out of range: the mesh has {nv} vertices"));
+    if nv > limits.vertices {
+        return Err(format!(
+            "the mesh declares {nv} vertices: more than the {} plie reads (three a triangle of {MAX_TRIANGLES})",
+            limits.vertices
+        ));
     }
     if nt == 0 {
         return Err("the mesh has no triangles".into());
     }
-    let triangles = idx.chunks_exact(3).map(|c| [c[0] as u32, c[1] as u32, c[2] as u32]).collect();
+    // Both fit in `usize` and `u32` now (the limits are far below 2^32), so indices are `u32`.
+    let (nv, nt) = (usize::try_from(nv).map_err(|_| "too many vertices")?, nt as usize);
+    if nv > u32::MAX as usize {
+        return Err(format!("{nv} vertices: more than 2^32 are not supported"));
+    }
+    let double = flags & 0x2000 != 0;
+    let real = if double { 8 } else { 4 };
+    let decode = |b: &[u8]| -> f32 {
+        if double {
+            f64::from_le_bytes(b.try_into().unwrap_or([0; 8])) as f32
+        } else {
+            f32::from_le_bytes(b.try_into().unwrap_or([0; 4]))
+        }
+    };
+    let mut positions: Vec<Vec3> = Vec::new();
+    r.records(nv, 3 * real, |b| {
+        let v = Vec3::new(decode(&b[..real]), decode(&b[real..2 * real]), decode(&b[2 * real..]));
+        if !v.is_finite() {
+            return Err(format!("vertex {} is not finite", positions.len()));
+        }
+        push(&mut positions, v, nv)
+    })?;
+    if flags & 0x0001 != 0 {
+        r.records(nv, 3 * real, |_| Ok(()))?;
+    }
+    let mut uvs: Vec<Vec2> = Vec::new();
+    if flags & 0x0002 != 0 {
+        r.records(nv, 2 * real, |b| push(&mut uvs, Vec2::new(decode(&b[..real]), decode(&b[real..])), nv))?;
+    }
+    if flags & 0x0008 != 0 {
+        r.records(nv, 3 * real, |_| Ok(()))?;
+    }
+    let mut triangles: Vec<[u32; 3]> = Vec::new();
+    r.records(nt, 12, |b| {
+        let t = [0, 4, 8].map(|o| u32::from_le_bytes(b[o..o + 4].try_into().unwrap_or([0; 4])));
+        if let Some(i) = t.iter().find(|&&i| i as usize >= nv) {
+            return Err(format!("triangle index {i} out of range: the mesh has {nv} vertices"));
+        }
+        push(&mut triangles, t, nt)
+    })?;
     Ok(TriMesh { positions, uvs, triangles })
+}
+
+/// Pushes `x` onto `v`, one of at most `n` (declared) elements: when full, `v` doubles, but never
+/// past `n`, and with `try_reserve_exact`, so an allocation that fails is an error, not an abort.
+fn push<T>(v: &mut Vec<T>, x: T, n: usize) -> std::result::Result<(), String> {
+    if v.len() == v.capacity() {
+        let more = v.len().max(1024).min(n.saturating_sub(v.len())).max(1);
+        v.try_reserve_exact(more).map_err(|e| format!("cannot allocate memory for the mesh: {e}"))?;
+    }
+    v.push(x);
+    Ok(())
 }
 
 /// The byte offset of mesh `index` from the table at the end of the file.
@@ -125,28 +182,57 @@ fn offset(bytes: &[u8], index: usize) -> std::result::Result<usize, String> {
 }
 
 /// Reads from the decompressed stream, only as much as is there.
-struct Reader<'a, 'b> {
-    z: &'a mut ZlibDecoder<&'b [u8]>,
+struct Reader<'b> {
+    z: ZlibDecoder<&'b [u8]>,
 }
 
-impl Reader<'_, '_> {
-    fn bytes(&mut self, n: usize) -> std::result::Result<Vec<u8>, String> {
-        let mut v = Vec::new();
-        (&mut *self.z).take(n as u64).read_to_end(&mut v).map_err(|e| format!("cannot decompress the mesh: {e}"))?;
-        if v.len() < n {
-            return Err("the compressed mesh data ends early".into());
+impl Reader<'_> {
+    /// Fills `buf` from the stream.
+    fn fill(&mut self, buf: &mut [u8]) -> std::result::Result<(), String> {
+        self.z.read_exact(buf).map_err(|e| match e.kind() {
+            std::io::ErrorKind::UnexpectedEof => "the compressed mesh data ends early".to_string(),
+            _ => format!("cannot decompress the mesh: {e}"),
+        })
+    }
+
+    /// Reads `n` records of `size` bytes, passing each to `each`, at most [`CHUNK_BYTES`] at a time.
+    fn records(
+        &mut self,
+        n: usize,
+        size: usize,
+        mut each: impl FnMut(&[u8]) -> std::result::Result<(), String>,
+    ) -> std::result::Result<(), String> {
+        let per_chunk = (CHUNK_BYTES / size).max(1);
+        let mut buf = vec![0; n.min(per_chunk) * size];
+        let mut left = n;
+        while left > 0 {
+            let k = left.min(per_chunk);
+            let b = &mut buf[..k * size];
+            self.fill(b)?;
+            for record in b.chunks_exact(size) {
+                each(record)?;
+            }
+            left -= k;
         }
-        Ok(v)
+        Ok(())
+    }
+
+    fn u8(&mut self) -> std::result::Result<u8, String> {
+        let mut b = [0; 1];
+        self.fill(&mut b)?;
+        Ok(b[0])
     }
 
     fn u32(&mut self) -> std::result::Result<u32, String> {
-        let b = self.bytes(4)?;
-        Ok(u32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+        let mut b = [0; 4];
+        self.fill(&mut b)?;
+        Ok(u32::from_le_bytes(b))
     }
 
     fn u64(&mut self) -> std::result::Result<u64, String> {
-        let b = self.bytes(8)?;
-        Ok(u64::from_le_bytes(b.try_into().unwrap_or([0; 8])))
+        let mut b = [0; 8];
+        self.fill(&mut b)?;
+        Ok(u64::from_le_bytes(b))
     }
 }
 
@@ -225,5 +311,78 @@ mod tests {
         let mut big = tri(0.0);
         big.triangles[0][2] = 7;
         assert!(parse_serialized(&write_serialized(&[big]), 0).unwrap_err().contains("out of range"));
+    }
+
+    /// A one-mesh file declaring `nv` vertices and `nt` triangles whose zlib stream holds three
+    /// vertices and then `zeros` zero bytes (all-zero triangles, or zero vertices): small, whatever
+    /// it declares.
+    fn bomb(nv: u64, nt: u64, zeros: usize) -> Vec<u8> {
+        use flate2::write::ZlibEncoder;
+        use std::io::Write;
+        let mut e = ZlibEncoder::new(Vec::new(), flate2::Compression::best());
+        let mut head = 0x1000u32.to_le_bytes().to_vec();
+        head.extend(b"m\0");
+        head.extend(nv.to_le_bytes());
+        head.extend(nt.to_le_bytes());
+        for v in [0.0f32, 1.0, 0.0, 0.3, 1.0, 0.0, 0.0, 1.0, 0.3] {
+            head.extend(v.to_le_bytes());
+        }
+        e.write_all(&head).unwrap();
+        let chunk = vec![0u8; 1 << 20];
+        let mut left = zeros;
+        while left > 0 {
+            let k = left.min(chunk.len());
+            e.write_all(&chunk[..k]).unwrap();
+            left -= k;
+        }
+        let mut out = MAGIC.to_le_bytes().to_vec();
+        out.extend(4u16.to_le_bytes());
+        out.extend(e.finish().unwrap());
+        out.extend(0u64.to_le_bytes());
+        out.extend(1u32.to_le_bytes());
+        out
+    }
+
+    /// Parses, expecting a one-line error containing `part`.
+    fn quick_error(file: &[u8], limits: Limits, part: &str) {
+        let e = parse_serialized_within(file, 0, limits).unwrap_err();
+        assert!(e.contains(part) && !e.contains('\n'), "{e}");
+    }
+
+    #[test]
+    fn declared_counts_over_the_limits_are_errors_before_decompressing() {
+        let limits = Limits::default();
+        // The reproducers' 2^26 and 2^28 triangles (3.1 GB and a 6.4 GB allocation before), and more.
+        for nt in [1 << 26, 1 << 28, MAX_TRIANGLES as u64 + 1, u64::MAX] {
+            let file = bomb(3, nt, 1 << 20);
+            assert!(file.len() < 4096, "{} bytes", file.len());
+            quick_error(&file, limits, "triangles: more than the 50000000");
+        }
+        for nv in [3 * MAX_TRIANGLES as u64 + 1, 1 << 40, u64::MAX] {
+            quick_error(&bomb(nv, 1, 1 << 20), limits, "vertices: more than the 150000000");
+        }
+        // What a scene has left of its budget.
+        let left = Limits { vertices: 1000, triangles: 10 };
+        quick_error(&bomb(3, 11, 1 << 10), left, "11 triangles: more than the 10 ");
+        quick_error(&bomb(1001, 1, 1 << 14), left, "1001 vertices: more than the 1000 ");
+        assert_eq!(parse_serialized_within(&bomb(3, 10, 120), 0, left).unwrap().triangles.len(), 10);
+    }
+
+    #[test]
+    fn declared_counts_under_the_limits_read_only_what_is_there() {
+        // The limit itself, 50,000,000 triangles (600 MB), declared by a file of a few kilobytes that
+        // holds 4 MB: an error once the data ends, the arrays grown only as far as it went.
+        let file = bomb(3, MAX_TRIANGLES as u64, 4 << 20);
+        assert!(file.len() < 16 << 10, "{} bytes", file.len());
+        quick_error(&file, Limits::default(), "ends early");
+        quick_error(&bomb(3 * MAX_TRIANGLES as u64, 1, 4 << 20), Limits::default(), "ends early");
+        // A whole bomb within the limits is a mesh: 2^20 all-zero triangles from about 12 KB.
+        let file = bomb(3, 1 << 20, 12 << 20);
+        assert!(file.len() < 64 << 10, "{} bytes", file.len());
+        let m = parse_serialized(&file, 0).unwrap();
+        assert_eq!((m.positions.len(), m.triangles.len()), (3, 1 << 20));
+        assert!(m.triangles.iter().all(|t| *t == [0; 3]));
+        // Grown by doubling, but not past the declared count.
+        assert_eq!((m.positions.capacity(), m.triangles.capacity()), (3, 1 << 20));
     }
 }

@@ -39,6 +39,28 @@ pub const CHUNK: usize = 8;
 /// `record_index` entry for "no data object".
 pub const NO_RECORD: u32 = u32::MAX;
 
+/// Limits of one construction that are not part of the P-LIE's parameters (issue 15). The P-LIE
+/// keeps them ([`Plie::limits`]) and its file stores them, so that a rebuild (`plie verify --full`)
+/// makes the same P-LIE.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Limits {
+    /// Bytes the blocker lists of the records and grid cells may take. A listed record that would
+    /// pass it is stored as [`RecordKind::Scene`] instead (degrading, never aborting); the decision
+    /// is made at the record's commit, in task order, so it does not depend on the thread count.
+    /// `None`: no limit.
+    pub list_bytes: Option<usize>,
+    /// Candidate clips the construction may spend gathering the records over the blocker cap again
+    /// with a cap up to 16 times larger (the lift, `construct::lift`); in a fixed order, so the
+    /// result does not depend on the thread count. `None`: no lifting (every record over the cap
+    /// stays a scene record).
+    pub lift_clips: Option<usize>,
+    /// Candidate clips the construction may spend gathering the cells of the records still over the
+    /// cap after the lift, each cell with a small cap (`construct::scene_cells`); in a fixed order,
+    /// so the result does not depend on the thread count. `None`: none (their cells outside the
+    /// umbra stay answered by the scene BVH).
+    pub cell_clips: Option<usize>,
+}
+
 /// How a record answers the rays through its face beyond its umbra.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 pub enum RecordKind {
@@ -138,6 +160,8 @@ pub struct Plie {
     /// The refinement (SPEC §4.8): per round, the nodes of the leaves split, in order (see
     /// [`crate::octree::Octree::split_nodes`]). Empty without refinement.
     pub splits: Vec<Vec<u32>>,
+    /// The limits it was built within.
+    pub limits: Limits,
 }
 
 impl Plie {

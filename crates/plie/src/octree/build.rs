@@ -87,20 +87,30 @@ impl Octree {
             params,
             depth: 0,
             scene_triangles: n,
+            capped: false,
         };
         let first_copy = first_copies(scene);
         let all = (0..n as u32).map(TriId).collect();
         let mut frontier = vec![Pending { node: 0, bounds: root, depth: 0, tris: all }];
+        let max_nodes = super::max_nodes(n);
         while !frontier.is_empty() {
-            let splits: Vec<Option<Split>> = frontier
+            let wants: Vec<bool> = frontier
                 .par_iter()
                 .map(|p| {
-                    let split = p.depth == 0
+                    p.depth == 0
                         || (p.depth < params.max_depth
                             && p.tris.len() > params.max_triangles
-                            && distinct(&p.tris, &first_copy) > params.max_triangles);
-                    split.then(|| split_cell(scene, &p.tris, &p.bounds, eps))
+                            && distinct(&p.tris, &first_copy) > params.max_triangles)
                 })
+                .collect();
+            // A level whose splits would pass the node cap splits nothing but the root (the same
+            // for any number of threads: the count is of the whole level).
+            let room = tree.nodes.len() + 8 * wants.iter().filter(|&&w| w).count() <= max_nodes;
+            tree.capped |= !room && frontier.iter().zip(&wants).any(|(p, &w)| w && p.depth > 0);
+            let splits: Vec<Option<Split>> = frontier
+                .par_iter()
+                .zip(&wants)
+                .map(|(p, &want)| (want && (room || p.depth == 0)).then(|| split_cell(scene, &p.tris, &p.bounds, eps)))
                 .collect();
             frontier = tree.place(frontier, splits);
         }
@@ -252,6 +262,30 @@ mod tests {
         let size = r.size();
         assert_eq!(size.x, size.y);
         assert_eq!(size.y, size.z);
+    }
+
+    /// A quad's two triangles with leaves of one triangle down to depth 16 would split along their
+    /// shared edge to over a million nodes; the node cap stops the build at a level, the same for
+    /// any thread count, and the octree stays valid.
+    #[test]
+    fn the_node_cap_bounds_an_octree_that_would_split_without_end() {
+        let mut b = SceneBuilder::new("quad");
+        let m = b.diffuse("grey", Vec3::splat(0.5));
+        b.quad(Vec3::ZERO, Vec3::Z, Vec3::new(1.0, 0.0, 1.0), Vec3::X, m);
+        b.light("light", &[Vec3::new(0.0, 2.0, 0.0), Vec3::new(0.1, 2.0, 0.0), Vec3::new(0.1, 2.0, 0.1)], Vec3::ONE);
+        let s = b.build().expect("valid scene");
+        let params = OctreeParams { max_triangles: 1, max_depth: 16 };
+        let o = Octree::build(&s, params).expect("valid octree parameters");
+        assert!(o.capped && o.node_count() <= crate::octree::max_nodes(s.triangles.len()), "{}", o.node_count());
+        assert!(o.node_count() > crate::octree::max_nodes(s.triangles.len()) / 8, "{}", o.node_count());
+        assert!(o.depth() < 16);
+        let report = o.validate(&s);
+        assert!(report.is_ok(), "{report}");
+        let one = rayon::ThreadPoolBuilder::new().num_threads(1).build().unwrap();
+        assert!(one.install(|| Octree::build(&s, params).unwrap()) == o, "the cap depends on the thread count");
+        // Below the cap nothing changes.
+        let small = Octree::build(&s, OctreeParams { max_triangles: 4, max_depth: 5 }).unwrap();
+        assert!(!small.capped);
     }
 
     #[test]

@@ -72,6 +72,15 @@ impl NodeId {
 /// and above the assignment tolerance.
 pub const MAX_DEPTH_LIMIT: u32 = 16;
 
+/// Most nodes an octree of a scene of `triangles` triangles may have: the build splits no cell of
+/// a level whose splits would pass it, and refinement (SPEC §4.8) stops before it. Far above what
+/// scenes need (an octree has fewer leaves than triangles at the defaults), it bounds the memory and
+/// time of parameters that would split without end (`--max-triangles 1 --max-depth 16` around
+/// triangles meeting at a point, or a long refinement chain).
+pub fn max_nodes(triangles: usize) -> usize {
+    (1 << 18).max(triangles.saturating_mul(4))
+}
+
 /// Octree build parameters (SPEC §3, §4.9).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 pub struct OctreeParams {
@@ -170,6 +179,9 @@ pub struct Octree {
     pub(crate) params: OctreeParams,
     pub(crate) depth: u32,
     pub(crate) scene_triangles: usize,
+    /// True if the node cap ([`max_nodes`]) kept the build from splitting a level: its leaves may
+    /// hold more than `max_triangles` above `max_depth`.
+    pub(crate) capped: bool,
 }
 
 /// Child `i` (bit 0: upper x, bit 1: upper y, bit 2: upper z) of the cell `b`. The split planes pass

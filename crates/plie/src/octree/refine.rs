@@ -48,6 +48,7 @@ impl Octree {
             params: self.params,
             depth: 0,
             scene_triangles: self.scene_triangles,
+            capped: self.capped,
         };
         let mut origin = Vec::with_capacity(t.leaves.capacity());
         let mut next = split.iter().peekable();

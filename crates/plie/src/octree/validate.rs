@@ -6,7 +6,7 @@
 //!   once from the root, root split, stored boxes equal to the boxes recomputed top-down, stored depths right;
 //! - ranges: every leaf's range lies in the flat list, ranges are disjoint and cover it, triangle ids
 //!   exist and each list is strictly ascending;
-//! - size: no leaf over `max_triangles` unless at `max_depth`;
+//! - size: no leaf over `max_triangles` unless at `max_depth` (or the node cap stopped the build);
 //! - assignment: for every triangle, the leaves it is listed in are exactly the leaves whose box grown
 //!   by `eps` it overlaps by [`triangle_overlaps_box`]. Candidates come from
 //!   [`Octree::for_each_leaf_overlapping`] on the triangle's bounding box, so the check costs about
@@ -270,7 +270,7 @@ impl Octree {
     fn check_sizes(&self, v: &mut Vec<Violation>) {
         for (i, leaf) in self.leaves.iter().enumerate() {
             let n = leaf.end.saturating_sub(leaf.start) as usize;
-            if n > self.params.max_triangles && leaf.depth < self.params.max_depth {
+            if n > self.params.max_triangles && leaf.depth < self.params.max_depth && !self.capped {
                 v.push(Violation::Overfull { leaf: LeafId(i as u32), triangles: n, depth: leaf.depth });
             }
         }

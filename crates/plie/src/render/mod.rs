@@ -2,6 +2,7 @@
 
 pub mod cpu_time;
 pub mod hit_buffer;
+pub mod memory;
 pub mod path;
 pub mod sampler;
 pub mod shade;
@@ -87,6 +88,10 @@ pub(crate) fn render(
 ) -> Result<Rendered> {
     settings.validate()?;
     camera.validate()?;
+    // The hits of the eye rays, and the pixels twice (the image and its output).
+    let (w, h, k) = (settings.width, settings.height, settings.eye_rays);
+    let per_pixel = u128::from(k * k) * std::mem::size_of::<Option<Hit>>() as u128 + 2 * 12;
+    memory::check(u128::from(w) * u128::from(h) * per_pixel, (w, h, k))?;
     let t0 = Instant::now();
     let hits = HitBuffer::build(scene, camera, (settings.width, settings.height, settings.eye_rays), bvh, octree);
     let hit_buffer_seconds = t0.elapsed().as_secs_f64();

@@ -204,6 +204,10 @@ impl Tracer<'_> {
                 continue;
             }
             let p_select = self.select[i];
+            if p_select <= 0.0 {
+                // A light too faint to be chosen by power, picked by the rounding of the last step.
+                continue;
+            }
             let mut rng = Rng::stream(self.seed, pixel, sample, key(bounce, Purpose::Light, i as u32));
             n_rooks(&mut rng, &mut s.samples);
             s.targets.clear();
@@ -339,13 +343,20 @@ pub fn render_path(
 ) -> Result<PathRendered> {
     settings.validate()?;
     path.validate()?;
+    // The pixels twice (the image and its output).
+    let (w, h) = (settings.width, settings.height);
+    super::memory::check(u128::from(w) * u128::from(h) * 2 * 12, (w, h, settings.eye_rays))?;
     camera.validate()?;
     let t0 = Instant::now();
-    let power: Vec<f32> = scene.lights.iter().map(|l| l.area * l.radiance.element_sum() / 3.0).collect();
-    let total: f32 = power.iter().sum();
+    // In f64: a light's power may be below f32's range (a faint light), or their sum above it.
+    let power: Vec<f64> =
+        scene.lights.iter().map(|l| f64::from(l.area) * f64::from(l.radiance.element_sum()) / 3.0).collect();
+    let total: f64 = power.iter().sum();
     let select: Vec<f32> = match path.nee {
+        Nee::Power if total > 0.0 && total.is_finite() => power.iter().map(|p| (p / total) as f32).collect(),
+        // No light with power to speak of: each as likely (what they add is as good as nothing).
+        Nee::Power => vec![1.0 / scene.lights.len() as f32; scene.lights.len()],
         Nee::All => vec![1.0; scene.lights.len()],
-        Nee::Power => power.iter().map(|p| p / total).collect(),
     };
     let mut acc = 0.0;
     let select_cdf = select

@@ -90,6 +90,11 @@ impl Light {
             let d = |i: usize, j: usize| vertices[i].as_dvec3() - vertices[j].as_dvec3();
             (d(2, 1) - d(3, 0)).length() <= 1e-5 * size as f64
         };
+        // Its power (area times radiance, summed over the channels) must be a finite f32, so that
+        // shading and the path tracer's choice of a light by power stay finite.
+        if !(area * radiance.element_sum()).is_finite() {
+            return Err(bad(&format!("radiance {radiance} times area {area} is beyond the range of f32")));
+        }
         Ok(Light { vertices, normal, area, radiance, triangles, fan_cdf, parallelogram })
     }
 

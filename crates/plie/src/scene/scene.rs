@@ -3,6 +3,8 @@
 //! triangles (zero area: they cannot block or be seen), counting them in
 //! [`Scene::degenerate_skipped`] so the caller can warn.
 
+use std::path::{Path, PathBuf};
+
 use glam::{Vec2, Vec3};
 
 use super::{Camera, Light, LightId, Material, MaterialId, Texture, TextureId, TriId};
@@ -40,6 +42,10 @@ pub struct Scene {
     /// What a scene file holds that plie reads but does not render (specular colours, textures,
     /// metallic-roughness), one sentence each, for the caller to warn about; empty for built-ins.
     pub warnings: Vec<String>,
+    /// Every file the loader read, as it named them: the scene file first, then the files it names
+    /// (MTL libraries, Mitsuba includes, meshes, textures, glTF buffers and images), each once; empty
+    /// for built-ins. A command must not write over any of them.
+    pub sources: Vec<PathBuf>,
 }
 
 impl Scene {
@@ -106,6 +112,8 @@ pub struct SceneBuilder {
     textures: Vec<Texture>,
     /// Per triangle once any triangle has texture coordinates (zeros for those without).
     tri_uv: Vec<[Vec2; 3]>,
+    /// Files read ([`Scene::sources`]).
+    sources: Vec<PathBuf>,
 }
 
 impl SceneBuilder {
@@ -148,6 +156,11 @@ impl SceneBuilder {
     pub fn texture(&mut self, t: Texture) -> TextureId {
         self.textures.push(t);
         TextureId(self.textures.len() as u32 - 1)
+    }
+
+    /// Records a file the loader read ([`Scene::sources`]); a file already recorded is not repeated.
+    pub fn source(&mut self, path: &Path) {
+        self.sources.push(path.to_path_buf());
     }
 
     /// Sets the scene's own image size.
@@ -302,6 +315,10 @@ impl SceneBuilder {
             bounds,
             degenerate_skipped,
             warnings: Vec::new(),
+            sources: {
+                let mut seen = std::collections::HashSet::new();
+                self.sources.into_iter().filter(|p| seen.insert(p.clone())).collect()
+            },
         })
     }
 }

@@ -4,8 +4,15 @@
 //! value there. Only shading reads textures; the P-LIE construction and every visibility mode ignore
 //! them, so images stay bit-identical across exact visibility modes.
 //!
+//! Texels are stored as narrow as the image file they come from ([`Texels`]): 8- and 16-bit channels
+//! as they are (3 or 6 bytes a texel) with a table of the linear value of each code, float channels
+//! (OpenEXR) as `f32` (12 bytes a texel, for exactness). A texel reads the same `f32` values either
+//! way, so the storage does not change an image.
+//!
 //! Texture coordinates follow Mitsuba and glTF: `(0, 0)` is the top-left corner of the image, `v`
 //! grows downward. Loaders whose format puts `v = 0` at the bottom (OBJ) flip `v` when they read it.
+
+use std::sync::Arc;
 
 use glam::{Vec2, Vec3};
 
@@ -33,6 +40,86 @@ pub enum Filter {
     Nearest,
 }
 
+/// The texels of a texture, row-major, top row first, in the width of the file they come from.
+/// [`Texels::get`] gives every texel as linear RGB.
+#[derive(Clone, PartialEq)]
+pub enum Texels {
+    /// 8 bits per channel (`r, g, b` per texel) and the linear value of each of the 256 codes.
+    Rgb8 {
+        /// The codes, three per texel.
+        codes: Vec<u8>,
+        /// The linear value of each code.
+        table: Box<[f32; 256]>,
+    },
+    /// 16 bits per channel (`r, g, b` per texel) and the linear value of each of the 65,536 codes.
+    Rgb16 {
+        /// The codes, three per texel.
+        codes: Vec<u16>,
+        /// The linear value of each code.
+        table: Box<[f32; 65536]>,
+    },
+    /// Linear RGB floats (float images, and textures made in code).
+    F32(Vec<Vec3>),
+}
+
+impl Texels {
+    /// Number of texels.
+    pub fn len(&self) -> usize {
+        match self {
+            Texels::Rgb8 { codes, .. } => codes.len() / 3,
+            Texels::Rgb16 { codes, .. } => codes.len() / 3,
+            Texels::F32(v) => v.len(),
+        }
+    }
+
+    /// True if there are no texels.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Texel `i` as linear RGB. Panics if `i` is out of range.
+    #[inline]
+    pub fn get(&self, i: usize) -> Vec3 {
+        match self {
+            Texels::Rgb8 { codes, table } => {
+                let c = &codes[3 * i..3 * i + 3];
+                Vec3::new(table[c[0] as usize], table[c[1] as usize], table[c[2] as usize])
+            }
+            Texels::Rgb16 { codes, table } => {
+                let c = &codes[3 * i..3 * i + 3];
+                Vec3::new(table[c[0] as usize], table[c[1] as usize], table[c[2] as usize])
+            }
+            Texels::F32(v) => v[i],
+        }
+    }
+
+    /// Every texel as linear RGB, in order.
+    pub fn iter(&self) -> impl Iterator<Item = Vec3> + '_ {
+        (0..self.len()).map(|i| self.get(i))
+    }
+
+    /// Bytes held, tables included.
+    pub fn bytes(&self) -> usize {
+        match self {
+            Texels::Rgb8 { codes, .. } => codes.len() + 256 * 4,
+            Texels::Rgb16 { codes, .. } => codes.len() * 2 + 65536 * 4,
+            Texels::F32(v) => v.len() * 12,
+        }
+    }
+}
+
+impl std::fmt::Debug for Texels {
+    /// The kind and size only (a texture has millions of texels).
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let kind = match self {
+            Texels::Rgb8 { .. } => "Rgb8",
+            Texels::Rgb16 { .. } => "Rgb16",
+            Texels::F32(_) => "F32",
+        };
+        write!(f, "Texels::{kind}({} texels)", self.len())
+    }
+}
+
 /// A bitmap texture of linear RGB texels.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Texture {
@@ -42,8 +129,9 @@ pub struct Texture {
     pub width: u32,
     /// Height in texels (at least 1).
     pub height: u32,
-    /// Linear RGB texels, row-major, top row first.
-    pub texels: Vec<Vec3>,
+    /// The texels, row-major, top row first; shared by the textures of one file (materials that use
+    /// it with different wrap modes or coordinate transforms).
+    pub texels: Arc<Texels>,
     /// Wrap mode in `u` and `v`.
     pub wrap: [Wrap; 2],
     /// Filter.
@@ -58,6 +146,11 @@ impl Texture {
     /// A texture of `width x height` linear texels, repeating, bilinear, no coordinate transform.
     /// `None` if the size does not match the texels or is zero.
     pub fn new(name: &str, width: u32, height: u32, texels: Vec<Vec3>) -> Option<Texture> {
+        Texture::from_texels(name, width, height, Arc::new(Texels::F32(texels)))
+    }
+
+    /// [`Texture::new`] with texels in any storage.
+    pub fn from_texels(name: &str, width: u32, height: u32, texels: Arc<Texels>) -> Option<Texture> {
         if width == 0 || height == 0 || texels.len() != width as usize * height as usize {
             return None;
         }
@@ -100,13 +193,15 @@ impl Texture {
         }
     }
 
-    fn texel(&self, x: usize, y: usize) -> Vec3 {
-        self.texels[y * self.width as usize + x]
+    /// The texel in column `x`, row `y` (row 0 at the top) as linear RGB.
+    #[inline]
+    pub fn texel(&self, x: usize, y: usize) -> Vec3 {
+        self.texels.get(y * self.width as usize + x)
     }
 
     /// The mean of all texels (what a renderer without texture coordinates would show).
     pub fn mean(&self) -> Vec3 {
-        self.texels.iter().copied().sum::<Vec3>() / self.texels.len() as f32
+        self.texels.iter().sum::<Vec3>() / self.texels.len() as f32
     }
 }
 

@@ -38,7 +38,7 @@ use self::xml::{parse_scene, register_ids, Elem};
 use super::input::{resolve_in_scene, short, LoadOptions};
 use super::lights::{self, EmissiveTriangle};
 use super::scene_name;
-use super::texture_file::load_texture;
+use super::texture_file::TextureFiles;
 use super::tri_mesh::TriMesh;
 use crate::error::{Error, Result};
 use crate::scene::texture::{Filter, Texture, Wrap};
@@ -56,6 +56,11 @@ pub fn load_mitsuba(path: &Path) -> Result<Scene> {
 
 /// [`load_mitsuba`] with options.
 pub fn load_mitsuba_with(path: &Path, opts: LoadOptions) -> Result<Scene> {
+    load_within(path, opts, MAX_TRIANGLES)
+}
+
+/// [`load_mitsuba_with`] with a triangle limit (lower in tests).
+fn load_within(path: &Path, opts: LoadOptions, max_triangles: usize) -> Result<Scene> {
     let doc = parse_scene(path, opts)?;
     let major = doc.version.split('.').next().and_then(|v| v.parse::<u32>().ok());
     if !matches!(major, Some(0) | Some(2) | Some(3)) {
@@ -66,15 +71,20 @@ pub fn load_mitsuba_with(path: &Path, opts: LoadOptions) -> Result<Scene> {
     let mut ids = HashMap::new();
     register_ids(&doc.root, &mut ids)?;
     let dir = path.parent().unwrap_or(Path::new("")).to_path_buf();
+    let mut b = SceneBuilder::new(&scene_name(path));
+    for f in &doc.files {
+        b.source(f);
+    }
     let mut l = Loader {
         dir,
         opts,
         ids,
-        b: SceneBuilder::new(&scene_name(path)),
+        b,
         bsdfs: HashMap::new(),
         meshes: HashMap::new(),
         materials: HashMap::new(),
         textures: HashMap::new(),
+        texture_files: TextureFiles::default(),
         emissive: Vec::new(),
         emissive_at: Vec::new(),
         changed: Vec::new(),
@@ -83,6 +93,9 @@ pub fn load_mitsuba_with(path: &Path, opts: LoadOptions) -> Result<Scene> {
         spectral: false,
         notes: Vec::new(),
         triangles: 0,
+        max_triangles,
+        loaded: (0, 0),
+        degenerate: 0,
         camera: false,
     };
     for e in &doc.root.children {
@@ -143,6 +156,8 @@ struct Loader<'a> {
     materials: HashMap<(*const Elem, [u32; 3], bool), MaterialId>,
     /// Loaded textures by [`TexSpec::key`], with their mean.
     textures: HashMap<String, (TextureId, Vec3)>,
+    /// Texture files decoded (each once, whatever the wrap modes and transforms using it).
+    texture_files: TextureFiles,
     emissive: Vec<EmissiveTriangle>,
     /// The shape element (file, line) of each emissive triangle.
     emissive_at: Vec<&'a Elem>,
@@ -157,6 +172,14 @@ struct Loader<'a> {
     /// Other warnings.
     notes: Vec<String>,
     triangles: usize,
+    /// The most triangles the scene may expand to: [`MAX_TRIANGLES`].
+    max_triangles: usize,
+    /// Vertices and triangles of the distinct mesh files read (kept in [`Loader::meshes`]), bounded
+    /// like the expanded scene: at most `max_triangles` triangles and three vertices a triangle.
+    loaded: (usize, usize),
+    /// Triangles naming a vertex twice, left out (see [`Loader::add_mesh`]) and added to
+    /// [`Scene::degenerate_skipped`].
+    degenerate: usize,
     camera: bool,
 }
 
@@ -304,16 +327,27 @@ impl<'a> Loader<'a> {
         radiance: Option<Vec3>,
     ) -> Result<()> {
         self.triangles += mesh.triangles.len();
-        if self.triangles > MAX_TRIANGLES {
-            return Err(e.error(format!("the scene expands to more than {MAX_TRIANGLES} triangles")));
+        if self.triangles > self.max_triangles {
+            return Err(e.error(format!("the scene expands to more than {} triangles", self.max_triangles)));
         }
-        let p: Vec<Vec3> = mesh.positions.iter().map(|&v| to_world.transform_point3(v)).collect();
-        if p.iter().any(|v| !v.is_finite()) {
-            return Err(e.error("a transformed vertex is not finite".into()));
-        }
+        // Vertices are placed as triangles use them, not copied all at once: a mesh may declare
+        // many more vertices than its triangles use (150 million from a 2 MB serialized file).
+        let place = |i: u32| to_world.transform_point3(mesh.positions[i as usize]);
+        let emits = radiance.is_some_and(|r| r.max_element() > 0.0);
         for t in &mesh.triangles {
-            let t = if flip { [t[0], t[2], t[1]] } else { *t };
-            let v = t.map(|i| p[i as usize]);
+            let placed = t.map(place);
+            if placed.iter().any(|v| !v.is_finite()) {
+                return Err(e.error("a transformed vertex is not finite".into()));
+            }
+            // A triangle naming a vertex twice has zero area wherever it is placed: the builder
+            // would drop it (and count it) anyway, so it is counted here without taking the
+            // builder's memory (a small zlib stream can hold millions). Emissive and textured ones
+            // go to the builder as before, which reports them exactly as it did.
+            if !emits && !textured && (t[0] == t[1] || t[1] == t[2] || t[0] == t[2]) {
+                self.degenerate += 1;
+                continue;
+            }
+            let (t, v) = if flip { ([t[0], t[2], t[1]], [placed[0], placed[2], placed[1]]) } else { (*t, placed) };
             let id = if textured {
                 self.b.triangle_uv(v, t.map(|i| mesh.uvs.get(i as usize).copied().unwrap_or_default()), m)
             } else {
@@ -337,11 +371,26 @@ impl<'a> Loader<'a> {
         if let Some(m) = self.meshes.get(&key) {
             return Ok(m.clone());
         }
+        let (max_vertices, max_triangles) = (3 * self.max_triangles, self.max_triangles);
+        // What is left of the budget: a serialized mesh's counts are checked against it before its
+        // data is decompressed (a zlib stream can declare and hold far more than its file's size).
+        let left = super::serialized::Limits {
+            vertices: max_vertices.saturating_sub(self.loaded.0) as u64,
+            triangles: max_triangles.saturating_sub(self.loaded.1) as u64,
+        };
         let mesh = Rc::new(match ty {
             "obj" => self.reading(e, super::obj::load_obj_mesh(&path, flip))?,
             "ply" => self.reading(e, super::ply::load_ply(&path))?,
-            _ => self.reading(e, super::serialized::load_serialized(&path, index))?,
+            _ => self.reading(e, super::serialized::load_serialized_within(&path, index, left))?,
         });
+        self.b.source(&path);
+        self.loaded.0 += mesh.positions.len();
+        self.loaded.1 += mesh.triangles.len();
+        if self.loaded.0 > max_vertices || self.loaded.1 > max_triangles {
+            return Err(e.error(format!(
+                "the scene's mesh files hold more than {max_triangles} triangles or {max_vertices} vertices"
+            )));
+        }
         self.meshes.insert(key, mesh.clone());
         Ok(mesh)
     }
@@ -454,7 +503,9 @@ impl<'a> Loader<'a> {
         if let Some(&t) = self.textures.get(&key) {
             return Ok(t);
         }
-        let tex = self.reading(e, load_texture(&spec.path, spec.srgb))?;
+        let tex = self.texture_files.load(&spec.path, spec.srgb);
+        let tex = self.reading(e, tex)?;
+        self.b.source(&spec.path);
         let tex = Texture { wrap: spec.wrap, filter: spec.filter, scale: spec.scale, offset: spec.offset, ..tex };
         let mean = tex.mean();
         let id = self.b.texture(tex);
@@ -490,11 +541,92 @@ impl<'a> Loader<'a> {
         lights::add_lights(&mut self.b, &self.emissive).map_err(|z| {
             self.emissive_at[z.index].error("an emissive triangle has zero area: a light must have an area".into())
         })?;
+        // The mesh files' arrays are copied into the builder: free them before it builds (for a
+        // scene at the triangle limit, hundreds of megabytes at the peak).
+        drop(std::mem::take(&mut self.meshes));
         let mut scene = self.b.build().map_err(|e| match e {
             Error::InvalidScene(m) => root.error(m),
             e => e,
         })?;
         scene.warnings = warnings;
+        scene.degenerate_skipped += self.degenerate;
         Ok(scene)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::io::serialized::write_serialized;
+
+    /// A scene of a light and serialized shapes `indices` of `mesh.serialized`, which holds `meshes`.
+    fn scene(meshes: &[TriMesh], indices: &[usize]) -> tempfile::TempDir {
+        let dir = tempfile::tempdir().unwrap();
+        std::fs::write(dir.path().join("mesh.serialized"), write_serialized(meshes)).unwrap();
+        let shapes: String = indices
+            .iter()
+            .map(|i| {
+                format!(
+                    r#"<shape type="serialized"><string name="filename" value="mesh.serialized"/><integer name="shape_index" value="{i}"/></shape>"#
+                )
+            })
+            .collect();
+        let xml = format!(
+            r#"<scene version="3.0.0"><shape type="rectangle"><emitter type="area"><rgb name="radiance" value="1"/></emitter></shape>{shapes}</scene>"#
+        );
+        std::fs::write(dir.path().join("scene.xml"), xml).unwrap();
+        dir
+    }
+
+    /// A mesh of `n` triangles over `3 n` vertices.
+    fn soup(n: u32) -> TriMesh {
+        TriMesh {
+            positions: (0..3 * n).map(|i| Vec3::new(i as f32, (i % 3) as f32, (i % 2) as f32)).collect(),
+            uvs: Vec::new(),
+            triangles: (0..n).map(|t| [3 * t, 3 * t + 1, 3 * t + 2]).collect(),
+        }
+    }
+
+    #[test]
+    fn the_mesh_files_of_a_scene_share_one_triangle_budget() {
+        // Three meshes of 4 triangles: two fit a limit of 10 (with the light's 2), the third is an
+        // error as soon as its header is read, naming its file.
+        let dir = scene(&[soup(4), soup(4), soup(4)], &[0, 1, 2]);
+        let path = dir.path().join("scene.xml");
+        let e = load_within(&path, LoadOptions::default(), 10).unwrap_err().to_string();
+        assert!(e.contains("mesh.serialized") && e.contains("declares 4 triangles: more than the 2 "), "{e}");
+        assert!(!e.contains('\n'), "{e}");
+        assert_eq!(load_within(&path, LoadOptions::default(), 14).unwrap().triangle_count(), 14);
+        // The vertex budget, three a triangle: 2 triangles over 30 vertices do not fit a limit of 9.
+        let mut wide = soup(10);
+        wide.triangles.truncate(2);
+        let dir = scene(&[wide], &[0]);
+        let e = load_within(&dir.path().join("scene.xml"), LoadOptions::default(), 9).unwrap_err().to_string();
+        assert!(e.contains("declares 30 vertices: more than the 27 "), "{e}");
+        // One mesh used twice is read once; its triangles count twice toward the expanded scene.
+        let dir = scene(&[soup(4)], &[0, 0]);
+        let path = dir.path().join("scene.xml");
+        assert_eq!(load_within(&path, LoadOptions::default(), 10).unwrap().triangle_count(), 10);
+        let e = load_within(&path, LoadOptions::default(), 9).unwrap_err().to_string();
+        assert!(e.contains("expands to more than 9 triangles"), "{e}");
+    }
+
+    #[test]
+    fn triangles_naming_a_vertex_twice_are_counted_as_the_builder_counts_them() {
+        let mut m = soup(2);
+        m.triangles.extend([[0, 0, 0], [1, 1, 2], [3, 4, 3]]);
+        let dir = scene(&[m], &[0]);
+        let s = load_within(&dir.path().join("scene.xml"), LoadOptions::default(), 100).unwrap();
+        assert_eq!((s.triangle_count(), s.degenerate_skipped), (2 + 2, 3));
+        // They still count toward the limit, and an emissive one is still an error.
+        let e = load_within(&dir.path().join("scene.xml"), LoadOptions::default(), 6).unwrap_err().to_string();
+        assert!(e.contains("expands to more than 6 triangles"), "{e}");
+        let xml = std::fs::read_to_string(dir.path().join("scene.xml")).unwrap().replace(
+            r#"value="0"/></shape>"#,
+            r#"value="0"/><emitter type="area"><rgb name="radiance" value="1"/></emitter></shape>"#,
+        );
+        std::fs::write(dir.path().join("scene.xml"), xml).unwrap();
+        let e = load_within(&dir.path().join("scene.xml"), LoadOptions::default(), 100).unwrap_err().to_string();
+        assert!(e.contains("zero area"), "{e}");
     }
 }
