@@ -43,6 +43,7 @@ pub fn run(a: &Args) -> Result<()> {
     a.threads.install()?;
     crate::checks::plie_output(&a.output, &a.scene.file().into_iter().collect::<Vec<_>>())?;
     let scene = a.scene.load()?;
+    crate::checks::outputs_are_not_sources(std::slice::from_ref(&a.output), &scene.sources)?;
     if !a.quiet {
         crate::scene_arg::warn_about(&scene);
     }

@@ -5,12 +5,10 @@
 //! The inputs a command knows before loading the scene (the scene file, `--plie`, `--camera-path`)
 //! are checked at once by [`output_is_not_input`]; the files the scene file names (its MTL libraries,
 //! textures, Mitsuba includes and meshes, glTF buffers and images) are known only once it is loaded
-//! ([`plie::Scene::sources`]), so [`output_is_not_input`] also remembers the output, and
-//! [`outputs_are_not_sources`] (called by `SceneArgs::load`) checks it against them, before any
-//! rendering or writing.
+//! ([`plie::Scene::sources`]), so each command checks its outputs against them with
+//! [`outputs_are_not_sources`] right after loading, before any rendering or writing.
 
 use std::path::{Path, PathBuf};
-use std::sync::Mutex;
 
 use anyhow::{bail, Result};
 
@@ -37,6 +35,19 @@ pub fn output_is_not_input(output: &Path, inputs: &[&Path]) -> Result<()> {
     if output.is_dir() {
         bail!("{}: is a directory; give a file name for -o", output.display());
     }
+    not_an_input(output, inputs)
+}
+
+/// Checks that none of `outputs` (checked by [`output_is_not_input`] before the scene was loaded)
+/// is one of `sources`, the files the loaded scene read ([`plie::Scene::sources`]); the same message.
+pub fn outputs_are_not_sources(outputs: &[PathBuf], sources: &[PathBuf]) -> Result<()> {
+    let sources: Vec<&Path> = sources.iter().map(PathBuf::as_path).collect();
+    outputs.iter().try_for_each(|output| not_an_input(output, &sources))
+}
+
+/// Checks that `output` is none of `inputs` (compared after resolving `.`, `..` and symbolic links,
+/// and by file identity when both exist).
+fn not_an_input(output: &Path, inputs: &[&Path]) -> Result<()> {
     let out = resolved(output);
     for input in inputs {
         if resolved(input) == out || same_file(output, input) {
@@ -45,39 +56,6 @@ pub fn output_is_not_input(output: &Path, inputs: &[&Path]) -> Result<()> {
                 output.display(),
                 input.display()
             );
-        }
-    }
-    OUTPUTS.lock().unwrap_or_else(|e| e.into_inner()).push(output.to_path_buf());
-    Ok(())
-}
-
-/// The outputs checked by [`output_is_not_input`] so far in this process: a command's outputs, for
-/// [`outputs_are_not_sources`].
-static OUTPUTS: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
-
-/// Checks that no output this command checked with [`output_is_not_input`] is one of `sources`, the
-/// files a loaded scene read ([`plie::Scene::sources`]), compared as there; the same message.
-pub fn outputs_are_not_sources(sources: &[PathBuf]) -> Result<()> {
-    let outputs = OUTPUTS.lock().unwrap_or_else(|e| e.into_inner()).clone();
-    outputs_are_not(&outputs, sources)
-}
-
-/// Checks that none of `outputs` is one of `inputs`.
-fn outputs_are_not(outputs: &[PathBuf], inputs: &[PathBuf]) -> Result<()> {
-    if outputs.is_empty() {
-        return Ok(());
-    }
-    let resolved_inputs: Vec<PathBuf> = inputs.iter().map(|p| resolved(p)).collect();
-    for output in outputs {
-        let out = resolved(output);
-        for (input, r) in inputs.iter().zip(&resolved_inputs) {
-            if *r == out || same_file(output, input) {
-                bail!(
-                    "{}: -o names an input of this command ({}); choose another output file",
-                    output.display(),
-                    input.display()
-                );
-            }
         }
     }
     Ok(())
@@ -187,24 +165,25 @@ mod tests {
         std::fs::write(&tex, "png").unwrap();
         std::fs::write(&mtl, "newmtl a").unwrap();
         let sources = [dir.path().join("s.obj"), mtl.clone(), tex.clone()];
-        assert!(outputs_are_not(&[dir.path().join("out.png")], &sources).is_ok());
+        assert!(outputs_are_not_sources(&[dir.path().join("out.png")], &sources).is_ok());
         std::fs::create_dir(dir.path().join("sub")).unwrap();
-        let e = outputs_are_not(&[dir.path().join("sub/../tex.png")], &sources).unwrap_err().to_string();
+        let e = outputs_are_not_sources(&[dir.path().join("sub/../tex.png")], &sources).unwrap_err().to_string();
         assert!(e.contains("names an input") && e.contains("tex.png") && !e.contains('\n'), "{e}");
-        assert!(outputs_are_not(std::slice::from_ref(&mtl), &sources).is_err(), "the MTL library");
+        assert!(outputs_are_not_sources(std::slice::from_ref(&mtl), &sources).is_err(), "the MTL library");
         #[cfg(unix)]
         {
             std::os::unix::fs::symlink(&tex, dir.path().join("link.png")).unwrap();
-            assert!(outputs_are_not(&[dir.path().join("link.png")], &sources).is_err(), "through a link");
+            assert!(outputs_are_not_sources(&[dir.path().join("link.png")], &sources).is_err(), "through a link");
             std::fs::hard_link(&tex, dir.path().join("hard.png")).unwrap();
-            assert!(outputs_are_not(&[dir.path().join("hard.png")], &sources).is_err(), "a hard link");
+            assert!(outputs_are_not_sources(&[dir.path().join("hard.png")], &sources).is_err(), "a hard link");
         }
-        // An output checked before loading is remembered for the check after.
+        // An output that passed the check before loading (the file did not exist then) is caught by
+        // the check after, against what the scene read.
         let out = dir.path().join("late.png");
         output_is_not_input(&out, &[]).unwrap();
         std::fs::write(&out, "png").unwrap();
-        assert!(outputs_are_not_sources(&[out]).is_err());
-        assert!(outputs_are_not_sources(&sources).is_ok());
+        assert!(outputs_are_not_sources(std::slice::from_ref(&out), std::slice::from_ref(&out)).is_err());
+        assert!(outputs_are_not_sources(&[out], &sources).is_ok());
     }
 
     #[test]

@@ -109,6 +109,7 @@ pub fn run(a: &Args, matches: &clap::ArgMatches) -> Result<()> {
     }
 
     let scene = a.scene.load()?;
+    crate::checks::outputs_are_not_sources(a.output.as_slice(), &scene.sources)?;
     if !a.quiet && !a.json {
         crate::scene_arg::warn_about(&scene);
     }

@@ -84,13 +84,12 @@ pub fn run(a: &Args, matches: &clap::ArgMatches) -> Result<()> {
     let inputs: Vec<&std::path::Path> =
         a.scene.file().into_iter().chain(a.plie.as_deref()).chain(a.camera_path.as_deref()).collect();
     let walk = a.camera_path.as_deref().map(|p| Plan::new(p, a.frames, &a.output, a.resume)).transpose()?;
-    match &walk {
-        Some(w) => {
-            for file in w.existing_files() {
-                crate::checks::output_is_not_input(&file, &inputs)?;
-            }
-        }
-        None => crate::checks::output_is_not_input(&a.output, &inputs)?,
+    let outputs: Vec<PathBuf> = match &walk {
+        Some(w) => w.existing_files().collect(),
+        None => vec![a.output.clone()],
+    };
+    for output in &outputs {
+        crate::checks::output_is_not_input(output, &inputs)?;
     }
     let mut settings = a.image.settings()?;
     if a.path.integrator == Integrator::Direct {
@@ -101,6 +100,7 @@ pub fn run(a: &Args, matches: &clap::ArgMatches) -> Result<()> {
     }
     let t = Instant::now();
     let scene = a.scene.load()?;
+    crate::checks::outputs_are_not_sources(&outputs, &scene.sources)?;
     let load_seconds = t.elapsed().as_secs_f64();
     if !a.quiet {
         crate::scene_arg::warn_about(&scene);

@@ -53,11 +53,7 @@ impl SceneArgs {
             bail!("{}: no such file", path.display());
         }
         let opts = plie::io::LoadOptions { allow_outside_paths: self.allow_outside_paths };
-        let scene =
-            plie::io::load_scene_with(path, opts).with_context(|| format!("cannot load scene {}", path.display()))?;
-        // The command's outputs were checked against the scene file; now against every file it read.
-        crate::checks::outputs_are_not_sources(&scene.sources)?;
-        Ok(scene)
+        plie::io::load_scene_with(path, opts).with_context(|| format!("cannot load scene {}", path.display()))
     }
 
     /// The scene file, when the scene is a file (an output must never overwrite it).

@@ -8,6 +8,8 @@ use std::io::Write;
 
 use flate2::write::ZlibEncoder;
 use plie::io::load_scene;
+use plie::io::mitsuba::MAX_TRIANGLES;
+use plie::io::serialized::{parse_serialized, parse_serialized_within, Limits};
 
 /// A light, so that a scene loads.
 const LIGHT: &str =
@@ -120,4 +122,47 @@ fn loading_is_linear_in_the_number_of_elements() {
     let path = dir.path().join("bsdfs.xml");
     std::fs::write(&path, bsdfs).unwrap();
     assert_eq!(load_scene(&path).unwrap().triangle_count(), 2);
+}
+
+/// Parses, expecting a one-line error containing `part`.
+fn quick_error(file: &[u8], limits: Limits, part: &str) {
+    let e = parse_serialized_within(file, 0, limits).unwrap_err();
+    assert!(e.contains(part) && !e.contains('\n'), "{e}");
+}
+
+#[test]
+fn declared_counts_over_the_limits_are_errors_before_decompressing() {
+    let limits = Limits::default();
+    // The reproducers' 2^26 and 2^28 triangles (3.1 GB and a 6.4 GB allocation before), and more.
+    for nt in [1 << 26, 1 << 28, MAX_TRIANGLES as u64 + 1, u64::MAX] {
+        let file = bomb(3, nt, 1 << 20);
+        assert!(file.len() < 4096, "{} bytes", file.len());
+        quick_error(&file, limits, "triangles: more than the 50000000");
+    }
+    for nv in [3 * MAX_TRIANGLES as u64 + 1, 1 << 40, u64::MAX] {
+        quick_error(&bomb(nv, 1, 1 << 20), limits, "vertices: more than the 150000000");
+    }
+    // What a scene has left of its budget.
+    let left = Limits { vertices: 1000, triangles: 10 };
+    quick_error(&bomb(3, 11, 1 << 10), left, "11 triangles: more than the 10 ");
+    quick_error(&bomb(1001, 1, 1 << 14), left, "1001 vertices: more than the 1000 ");
+    assert_eq!(parse_serialized_within(&bomb(3, 10, 120), 0, left).unwrap().triangles.len(), 10);
+}
+
+#[test]
+fn declared_counts_under_the_limits_read_only_what_is_there() {
+    // The limit itself, 50,000,000 triangles (600 MB), declared by a file of a few kilobytes that
+    // holds 4 MB: an error once the data ends, the arrays grown only as far as it went.
+    let file = bomb(3, MAX_TRIANGLES as u64, 4 << 20);
+    assert!(file.len() < 16 << 10, "{} bytes", file.len());
+    quick_error(&file, Limits::default(), "ends early");
+    quick_error(&bomb(3 * MAX_TRIANGLES as u64, 1, 4 << 20), Limits::default(), "ends early");
+    // A whole bomb within the limits is a mesh: 2^20 all-zero triangles from about 12 KB.
+    let file = bomb(3, 1 << 20, 12 << 20);
+    assert!(file.len() < 64 << 10, "{} bytes", file.len());
+    let m = parse_serialized(&file, 0).unwrap();
+    assert_eq!((m.positions.len(), m.triangles.len()), (3, 1 << 20));
+    assert!(m.triangles.iter().all(|t| *t == [0; 3]));
+    // Grown by doubling, but not past the declared count.
+    assert_eq!((m.positions.capacity(), m.triangles.capacity()), (3, 1 << 20));
 }
