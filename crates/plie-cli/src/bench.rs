@@ -5,7 +5,9 @@
 //! buffer (pass 2 alone) for every visibility mode but brute, and for the P-LIE modes on the refined
 //! P-LIE (the "+u" columns of Tables A.1-A.3), at the thesis' image settings; shadow-ray throughput
 //! with one thread and with all; and the break-even number of images. The files are written by
-//! [`crate::bench_report`].
+//! [`crate::bench_report`]. The options and scene names are checked before anything is measured, and
+//! the `--out` folder is created only when the files are written ([`crate::out_dir`]): a run that
+//! fails leaves no folder behind.
 
 use std::path::PathBuf;
 use std::time::Instant;
@@ -22,6 +24,8 @@ use plie::{Camera, Environment, Scene, Shadows};
 use plie::{Grids, PlieParams, Propagation, Regions};
 
 use crate::bench_data::{median, BreakEven, BuildResult, Plan, Results, SceneResult, Shading};
+use crate::bench_path::PathPlan;
+use crate::out_dir::OutDir;
 use crate::progress::Bar;
 use crate::scene_arg::SceneArgs;
 
@@ -35,7 +39,8 @@ pub struct Args {
     /// stress scene `balusters`).
     #[arg(long, value_name = "A,B,...", value_delimiter = ',')]
     scenes: Vec<String>,
-    /// Directory for report.md, results.csv, results.json and shading.svg (created if missing).
+    /// Directory for report.md, results.csv, results.json and shading.svg (created if missing, when
+    /// they are written; a run that fails leaves no directory it created).
     #[arg(long, default_value = "bench-out", value_name = "DIR")]
     out: PathBuf,
     /// Runs per measurement, 1 to 1000; the median is reported (default 5, 1 with --quick and with
@@ -54,21 +59,21 @@ pub struct Args {
     /// mode against `none` (no shadow test) and `embree`, on the ten built-in scenes and the shared
     /// cornell-bunny, cornell-dragon-100k and conference-lit (writes soft-shadows.md/.json; runs
     /// default to 3).
-    #[arg(long)]
+    #[arg(long, conflicts_with = "path")]
     soft_shadows: bool,
     /// With --soft-shadows: the folder of the shared scenes.
-    #[arg(long, default_value = "../shared/scenes", value_name = "DIR")]
+    #[arg(long, default_value = "../shared/scenes", value_name = "DIR", requires = "soft_shadows")]
     shared: PathBuf,
     /// Measure the path-tracing table instead (path.md, path.json): max depth 3 and 5, 16 paths per
     /// pixel, on the ten built-in scenes and the conference room (default; --quick: cornell-cube-1 and
     /// cornell-cube-3, 32x32).
     #[arg(long)]
     path: bool,
-    /// Path table: image width and height (default 64; 32 with --quick).
-    #[arg(long, value_name = "W")]
+    /// Path table: image width and height, 1 to 4096 (default 64; 32 with --quick).
+    #[arg(long, value_name = "W", requires = "path", value_parser = clap::value_parser!(u32).range(1..=4096))]
     path_size: Option<u32>,
     /// Path table: the visibility modes (default bvh,grid).
-    #[arg(long, value_name = "A,B,...", value_delimiter = ',')]
+    #[arg(long, value_name = "A,B,...", value_delimiter = ',', requires = "path")]
     path_modes: Vec<Mode>,
 }
 
@@ -87,25 +92,72 @@ fn plan(a: &Args) -> Result<Plan> {
     Ok(Plan { scenes, sizes, shadow_rays, runs, modes, refined_modes })
 }
 
-pub fn run(a: &Args) -> Result<()> {
-    a.threads.install()?;
-    std::fs::create_dir_all(&a.out).with_context(|| format!("cannot create directory {}", a.out.display()))?;
-    if a.soft_shadows {
+/// What `plie bench` measures.
+enum Table {
+    /// The thesis' protocol.
+    Thesis(Plan),
+    /// `--soft-shadows` ([`crate::bench_soft`]).
+    SoftShadows { scenes: Vec<String>, runs: usize },
+    /// `--path` ([`crate::bench_path`]).
+    Path(PathPlan),
+}
+
+impl Table {
+    fn scenes(&self) -> &[String] {
+        match self {
+            Table::Thesis(plan) => &plan.scenes,
+            Table::SoftShadows { scenes, .. } => scenes,
+            Table::Path(p) => &p.scenes,
+        }
+    }
+}
+
+/// The table `a` asks for, its options and scenes checked: whatever they get wrong is found before
+/// anything is measured or written.
+fn table(a: &Args) -> Result<Table> {
+    let table = if a.soft_shadows {
         let scenes = if a.scenes.is_empty() { crate::bench_soft::default_scenes(&a.shared) } else { a.scenes.clone() };
         let runs = a.runs.map_or(if a.quick { 1 } else { 3 }, |r| r as usize);
-        anyhow::ensure!(runs >= 1, "--runs must be at least 1");
-        return crate::bench_soft::run(&scenes, &a.out, runs, a.quiet);
+        Table::SoftShadows { scenes, runs }
+    } else if a.path {
+        Table::Path(path_plan(a, plan(a)?))
+    } else {
+        Table::Thesis(plan(a)?)
+    };
+    for name in table.scenes() {
+        let scene = SceneArgs { scene: name.clone(), allow_outside_paths: false };
+        scene.check_exists().with_context(|| format!("scene {name}"))?;
     }
-    let plan = plan(a)?;
-    if a.path {
-        return run_path(a, plan);
+    Ok(table)
+}
+
+pub fn run(a: &Args) -> Result<()> {
+    a.threads.install()?;
+    let table = table(a)?;
+    // Checked now, created when the first file is written, removed again if this run fails.
+    let mut out = OutDir::new(&a.out)?;
+    match table {
+        Table::SoftShadows { scenes, runs } => crate::bench_soft::run(&scenes, &mut out, runs, a.quiet)?,
+        Table::Path(p) => {
+            crate::bench_path::run(&p, &mut out, &Bar::new(a.quiet))?;
+            if !a.quiet {
+                eprintln!("wrote {}/{{path.md, path.json}}", a.out.display());
+            }
+        }
+        Table::Thesis(plan) => run_thesis(a, &plan, &mut out)?,
     }
+    out.keep();
+    Ok(())
+}
+
+/// The thesis' protocol on `plan`'s scenes, written by [`crate::bench_report`].
+fn run_thesis(a: &Args, plan: &Plan, out: &mut OutDir) -> Result<()> {
     let one = rayon::ThreadPoolBuilder::new().num_threads(1).build()?;
     let bar = Bar::new(a.quiet);
     bar.start("bench", plan.steps_per_scene(rayon::current_num_threads()) * plan.scenes.len() as u64);
     let mut scenes = Vec::new();
     for name in &plan.scenes {
-        scenes.push(bench_scene(name, &plan, &one, &bar).with_context(|| format!("scene {name}"))?);
+        scenes.push(bench_scene(name, plan, &one, &bar).with_context(|| format!("scene {name}"))?);
     }
     bar.finish();
     let results = Results {
@@ -120,15 +172,15 @@ pub fn run(a: &Args) -> Result<()> {
         throughput_setting: plan.throughput_setting(),
         scenes,
     };
-    crate::bench_report::write_all(&a.out, &a.thesis, &plan, &results)?;
+    crate::bench_report::write_all(out, &a.thesis, plan, &results)?;
     if !a.quiet {
         eprintln!("wrote {}/{{report.md, results.csv, results.json, shading.svg}}", a.out.display());
     }
     Ok(())
 }
 
-/// `plie bench --path`: the path-tracing table ([`crate::bench_path`]).
-fn run_path(a: &Args, plan: Plan) -> Result<()> {
+/// The path table `a` asks for (`--path`), on `plan`'s scenes and the conference room.
+fn path_plan(a: &Args, plan: Plan) -> PathPlan {
     let mut scenes = plan.scenes;
     let conference = std::path::Path::new("../shared/scenes/conference-lit.obj");
     if a.scenes.is_empty() && !a.quick {
@@ -139,22 +191,15 @@ fn run_path(a: &Args, plan: Plan) -> Result<()> {
         }
     }
     let modes = if a.path_modes.is_empty() { vec![Mode::Bvh, Mode::Grid] } else { a.path_modes.clone() };
-    let size = a.path_size.unwrap_or(if a.quick { 32 } else { 64 });
-    anyhow::ensure!((1..=4096).contains(&size), "--path-size must be between 1 and 4096");
-    let p = crate::bench_path::PathPlan {
+    PathPlan {
         scenes,
-        size,
+        size: a.path_size.unwrap_or(if a.quick { 32 } else { 64 }),
         spp: 16,
         shadow_rays: 4,
         depths: vec![3, 5],
         modes,
         runs: a.runs.map_or(1, |r| r as usize),
-    };
-    crate::bench_path::run(&p, &a.out, &Bar::new(a.quiet))?;
-    if !a.quiet {
-        eprintln!("wrote {}/{{path.md, path.json}}", a.out.display());
     }
-    Ok(())
 }
 
 /// Loads a built-in scene or a scene file, with its camera (or a framing default).

@@ -8,8 +8,6 @@
 //! `path.json` in the output directory. Native Embree joins as a column where the `embree` mode is
 //! available and asked for (`--path-modes`).
 
-use std::path::Path;
-
 use anyhow::{Context, Result};
 use plie::visibility::Mode;
 use plie::PlieParams;
@@ -18,6 +16,7 @@ use plie::{Nee, PathSettings};
 use plie::{Progress, RenderSettings};
 use serde::Serialize;
 
+use crate::out_dir::OutDir;
 use crate::progress::Bar;
 use crate::scene_arg::{CameraArgs, SceneArgs};
 
@@ -61,7 +60,7 @@ fn camera_for(name: &str) -> (Option<glam::Vec3>, Option<glam::Vec3>, Option<f32
 }
 
 /// Runs the path table and writes `path.md` and `path.json` into `out`.
-pub fn run(plan: &PathPlan, out: &Path, bar: &Bar) -> Result<()> {
+pub fn run(plan: &PathPlan, out: &mut OutDir, bar: &Bar) -> Result<()> {
     let mut modes = plan.modes.clone();
     if !modes.contains(&Mode::None) {
         modes.push(Mode::None);
@@ -128,15 +127,9 @@ pub fn run(plan: &PathPlan, out: &Path, bar: &Bar) -> Result<()> {
     }
     bar.finish();
     let md = markdown(plan, &rows);
-    write(&out.join("path.md"), &md)?;
-    write(&out.join("path.json"), &(serde_json::to_string_pretty(&rows)? + "\n"))?;
+    out.write("path.md", &md)?;
+    out.write("path.json", &(serde_json::to_string_pretty(&rows)? + "\n"))?;
     Ok(())
-}
-
-fn write(path: &Path, text: &str) -> Result<()> {
-    let io = |e| plie::Error::Io { path: path.to_path_buf(), source: e };
-    plie::io::write_atomic(path, |w| w.write_all(text.as_bytes()).map_err(io))
-        .with_context(|| format!("cannot write {}", path.display()))
 }
 
 /// The Markdown table: one row per scene, depth and mode.

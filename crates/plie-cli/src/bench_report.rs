@@ -10,6 +10,7 @@ use anyhow::{Context, Result};
 use plie::visibility::Mode;
 
 use crate::bench_data::{seconds_of, Plan, Results};
+use crate::out_dir::OutDir;
 
 /// The thesis' figures (shared/thesis/*.tsv).
 #[derive(Default)]
@@ -72,20 +73,16 @@ fn thesis_name(scene: &str) -> String {
 }
 
 /// Writes report.md, results.csv, results.json and shading.svg into `out`.
-pub fn write_all(out: &Path, thesis_dir: &Path, plan: &Plan, r: &Results) -> Result<()> {
+pub fn write_all(out: &mut OutDir, thesis_dir: &Path, plan: &Plan, r: &Results) -> Result<()> {
     let thesis = Thesis::load(thesis_dir);
     let report = markdown(plan, r, thesis_dir, thesis.as_ref().map_err(|e| format!("{e:#}")));
-    write_text(&out.join("report.md"), &report)?;
-    write_text(&out.join("results.csv"), &csv(r))?;
-    write_text(&out.join("results.json"), &(serde_json::to_string_pretty(r)? + "\n"))?;
-    write_text(&out.join("shading.svg"), &crate::bench_chart::svg(plan, r)?)?;
+    let json = serde_json::to_string_pretty(r)? + "\n";
+    let svg = crate::bench_chart::svg(plan, r)?;
+    out.write("report.md", &report)?;
+    out.write("results.csv", &csv(r))?;
+    out.write("results.json", &json)?;
+    out.write("shading.svg", &svg)?;
     Ok(())
-}
-
-pub fn write_text(path: &Path, text: &str) -> Result<()> {
-    let io = |e| plie::Error::Io { path: path.to_path_buf(), source: e };
-    plie::io::write_atomic(path, |w| w.write_all(text.as_bytes()).map_err(io))
-        .with_context(|| format!("cannot write {}", path.display()))
 }
 
 /// One row per measurement: construction, then shading (all threads and 1 thread).

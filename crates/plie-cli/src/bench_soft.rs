@@ -23,6 +23,8 @@ use plie::RefineParams;
 use plie::{Camera, Environment, Scene, Shadows};
 use serde::Serialize;
 
+use crate::out_dir::OutDir;
+
 /// Image size (width = height) of the table.
 const SIZE: u32 = 254;
 /// Shadow rays per light of the table.
@@ -142,7 +144,7 @@ fn load(name: &str) -> Result<(Scene, Camera)> {
 }
 
 /// Measures every column at every shadow-ray count on `scenes` and writes the report into `out`.
-pub fn run(scenes: &[String], out: &Path, runs: usize, quiet: bool) -> Result<()> {
+pub fn run(scenes: &[String], out: &mut OutDir, runs: usize, quiet: bool) -> Result<()> {
     let mut rows = Vec::new();
     for name in scenes {
         let (scene, camera) = load(name).with_context(|| format!("scene {name}"))?;
@@ -216,10 +218,10 @@ pub fn run(scenes: &[String], out: &Path, runs: usize, quiet: bool) -> Result<()
         size: SIZE,
         rows,
     };
-    crate::bench_report::write_text(&out.join("soft-shadows.json"), &(serde_json::to_string_pretty(&results)? + "\n"))?;
-    crate::bench_report::write_text(&out.join("soft-shadows.md"), &report(&results))?;
+    out.write("soft-shadows.json", &(serde_json::to_string_pretty(&results)? + "\n"))?;
+    out.write("soft-shadows.md", &report(&results))?;
     if !quiet {
-        eprintln!("wrote {}/{{soft-shadows.md, soft-shadows.json}}", out.display());
+        eprintln!("wrote {}/{{soft-shadows.md, soft-shadows.json}}", out.path().display());
     }
     Ok(())
 }

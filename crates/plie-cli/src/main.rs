@@ -13,6 +13,7 @@ mod build;
 mod checks;
 mod image_args;
 mod inspect;
+mod out_dir;
 mod path_args;
 mod plie_args;
 mod progress;

@@ -45,15 +45,23 @@ impl SceneArgs {
         if builtin::exists(&self.scene) {
             return Ok(builtin::load(&self.scene)?);
         }
+        self.check_exists()?;
         let path = Path::new(&self.scene);
-        if !path.exists() {
-            if path.extension().is_none() {
-                return Err(builtin::load(&self.scene).unwrap_err().into());
-            }
-            bail!("{}: no such file", path.display());
-        }
         let opts = plie::io::LoadOptions { allow_outside_paths: self.allow_outside_paths };
         plie::io::load_scene_with(path, opts).with_context(|| format!("cannot load scene {}", path.display()))
+    }
+
+    /// Fails as [`SceneArgs::load`] would if the scene is neither a built-in name nor a file, without
+    /// loading it (a command that loads its scenes late checks them all first).
+    pub fn check_exists(&self) -> Result<()> {
+        let path = Path::new(&self.scene);
+        if builtin::exists(&self.scene) || path.exists() {
+            return Ok(());
+        }
+        if path.extension().is_none() {
+            return Err(builtin::load(&self.scene).unwrap_err().into());
+        }
+        bail!("{}: no such file", path.display());
     }
 
     /// The scene file, when the scene is a file (an output must never overwrite it).

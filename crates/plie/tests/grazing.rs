@@ -14,9 +14,9 @@ use std::f32::consts::TAU;
 
 use glam::{Mat3, Vec2, Vec3};
 use plie::internals::lie::PlieParams;
-use plie::visibility::{LightRays, Mode, QueryCtx, ShadowRay};
+use plie::visibility::{LightRays, QueryCtx};
 use plie::{LightId, Scene, SceneBuilder, TriId};
-use support::{start_point, Built, TestRng};
+use support::{start_point, Built, ExactModes, TestRng};
 
 /// A random grazing scene (see the module's doc) of at most `max_strips` strips of floor.
 fn grazing_scene(rng: &mut TestRng, max_strips: usize) -> Scene {
@@ -134,12 +134,9 @@ fn floor_point(scene: &Scene, rng: &mut TestRng) -> (Vec3, TriId) {
 /// found occluded.
 fn check(scene: &Scene, what: &str, params: PlieParams, per_point: usize, rng: &mut TestRng) -> (usize, usize) {
     let built = Built::new(scene, params);
-    let brute = built.vis(scene, Mode::Brute);
-    let modes: Vec<_> =
-        Mode::EXACT.into_iter().filter(|&m| m != Mode::Brute).map(|m| (m, built.vis(scene, m))).collect();
+    let mut modes = ExactModes::new(&built, scene);
     let mut ctx = QueryCtx::new(scene.triangles.len());
     let (mut rays, mut blocked) = (0, 0);
-    let mut out = Vec::new();
     let mut tried = 0;
     while tried < per_point * 4 && rays < per_point * 64 {
         tried += 1;
@@ -158,24 +155,8 @@ fn check(scene: &Scene, what: &str, params: PlieParams, per_point: usize, rng: &
             light: LightId(li as u32),
             targets: &targets,
         };
-        let reference: Vec<bool> = (0..64).map(|k| brute.occluded(&q.ray(k), &mut ctx)).collect();
         rays += 64;
-        blocked += reference.iter().filter(|&&b| b).count();
-        for (mode, vis) in &modes {
-            out.clear();
-            out.resize(64, false);
-            vis.occluded_light(&q, &mut out, &mut ctx);
-            for k in 0..64 {
-                let ray: ShadowRay = q.ray(k);
-                let per_ray = vis.occluded(&ray, &mut ctx);
-                assert!(
-                    per_ray == reference[k] && out[k] == reference[k],
-                    "{what}: {mode}: per-ray {per_ray}, per-light {}, brute force {} for {ray:?}",
-                    out[k],
-                    reference[k],
-                );
-            }
-        }
+        blocked += modes.check(what, &q, &mut ctx);
     }
     (rays, blocked)
 }

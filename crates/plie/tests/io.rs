@@ -171,7 +171,8 @@ fn faces_without_usemtl_get_the_default_material() {
 
 #[test]
 fn polygons_weights_and_relative_indices() {
-    let obj = b"mtllib l.mtl\nusemtl lamp\nv 0 0 0 2\nv 2 0 0 2\nv 2 2 0 2\nv 0 2 0 2\nf -4/1/1 -3//2 -2 -1\n";
+    let obj = b"mtllib l.mtl\nusemtl lamp\nv 0 0 0 2\nv 2 0 0 2\nv 2 2 0 2\nv 0 2 0 2\nvt 0 0\nvn 0 0 1\nvn 0 0 1\n\
+                f -4/1/1 -3//2 -2 -1\n";
     let s = load_from(&[("a.obj", obj), ("l.mtl", b"newmtl lamp\nKe 1 1 1\n")], "a.obj").unwrap();
     assert_eq!(s.triangle_count(), 2);
     assert_eq!(s.lights[0].vertices.len(), 4);
@@ -290,9 +291,76 @@ fn binary_garbage_and_odd_inputs() {
     let msg =
         parse_error(load_from(&[("b.obj", &[0x89, b'P', b'N', b'G', 0xff, 0xfe, b'\n'])], "b.obj"), "b.obj", Some(1));
     assert!(msg.contains("UTF-8"), "{msg}");
-    // Lines, points, normals and texture coordinates are ignored, whatever they hold.
-    let s = lit(b"v 0 0 0\nv 1 0 0\nv 0 1 0\nvn x\nvt\nl 1 99\np 7\ns off\nf 1//1 2/5/ 3/x/y\n").unwrap();
+    // Lines, points, normals and texture coordinates are ignored, whatever they hold (but a face's
+    // indices must name ones that exist).
+    let s = lit(b"v 0 0 0\nv 1 0 0\nv 0 1 0\nvn x\nvt\nl 1 99\np 7\ns off\nf 1//1 2/1/ 3/1/-1\n").unwrap();
     assert_eq!(s.triangle_count(), 1);
+}
+
+#[test]
+fn texture_and_normal_indices_out_of_range() {
+    // They were dropped without a word; now they are errors like a vertex index (the face is line 8).
+    let head = "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvn 0 0 1\n";
+    for (face, needle) in [
+        ("f 1/2 2/1 3/1", "texture coordinate index 2 out of range: 1 texture coordinates (vt) are defined"),
+        ("f 1/1 2/1 3/-2", "texture coordinate index -2 out of range"),
+        ("f 1/0 2/1 3/1", "texture coordinate index 0"),
+        ("f 1/1/1 2/1/1 3/1/2", "normal index 2 out of range: 1 normals (vn) are defined"),
+        ("f 1//1 2//-2 3//1", "normal index -2 out of range"),
+        ("f 1//x 2//1 3//1", "malformed normal index '1//x'"),
+    ] {
+        let msg = parse_error(lit(format!("{head}{face}\n").as_bytes()), "t.obj", Some(8));
+        assert!(msg.contains(needle), "{face}: {msg}");
+    }
+    // Only texture coordinates and normals defined before the face count.
+    let msg = parse_error(lit(b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1/1 2/1 3/1\nvt 0 0\n"), "t.obj", Some(6));
+    assert!(msg.contains("texture coordinate index 1 out of range: 0 texture"), "{msg}");
+    // Relative (negative) indices keep working, for all three.
+    let s = lit(format!("{head}vt 1 0\nf -3/-2/-1 -2/-1/-1 -1/-1/1\n").as_bytes()).unwrap();
+    assert_eq!(s.triangle_count(), 1);
+}
+
+#[test]
+fn non_finite_mtl_values() {
+    // Also in statements plie ignores (d, Tr, Ns, Ks): the file is broken, whatever reads it.
+    for stmt in ["d nan", "Tr -inf", "Ns 1e39", "Ks 0 NaN 0", "Kd 1 nan 1", "Ke 1 1 inf", "d -halo nan", "Ni infinity"]
+    {
+        let mtl = format!("newmtl lamp\nKe 1 1 1\n{stmt}\n");
+        let files: &[(&str, &[u8])] = &[("t.obj", b"mtllib l.mtl\nusemtl lamp\n"), ("l.mtl", mtl.as_bytes())];
+        let msg = parse_error(load_from(files, "t.obj"), "l.mtl", Some(3));
+        let keyword = stmt.split(' ').next().unwrap();
+        assert!(msg.contains(keyword) && msg.contains("non-finite"), "{stmt}: {msg}");
+    }
+    // Words that are not numbers are left alone.
+    let mut obj = b"mtllib l.mtl\nusemtl lamp\n".to_vec();
+    obj.extend_from_slice(V3);
+    obj.extend_from_slice(b"f 1 2 3\n");
+    let files: &[(&str, &[u8])] = &[("t.obj", &obj), ("l.mtl", b"newmtl lamp\nKe 1 1 1\nd -halo 0.5\nTf xyz 1 1 1\n")];
+    assert_eq!(load_from(files, "t.obj").unwrap().lights.len(), 1);
+}
+
+#[test]
+fn byte_order_marks_and_line_endings() {
+    let obj = "mtllib l.mtl\nusemtl lamp\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
+    let mtl = "newmtl lamp\nKe 1 1 1\n";
+    let bom = "\u{FEFF}";
+    for (ending, with_bom) in [("\r", false), ("\r\n", false), ("\n", true), ("\r", true), ("\r\n", true)] {
+        let bom = if with_bom { bom } else { "" };
+        let obj = format!("{bom}{}", obj.replace('\n', ending));
+        let mtl = format!("{bom}{}", mtl.replace('\n', ending));
+        let s = load_from(&[("t.obj", obj.as_bytes()), ("l.mtl", mtl.as_bytes())], "t.obj");
+        let s = s.unwrap_or_else(|e| panic!("{ending:?}, BOM {with_bom}: {e}"));
+        assert_eq!((s.triangle_count(), s.lights.len()), (1, 1), "{ending:?}, BOM {with_bom}");
+    }
+    // Errors in a file with old Mac line endings name the right line.
+    let obj = obj.replace("f 1 2 3", "f 1 2 4").replace('\n', "\r");
+    let msg =
+        parse_error(load_from(&[("t.obj", obj.as_bytes()), ("l.mtl", mtl.as_bytes())], "t.obj"), "t.obj", Some(6));
+    assert!(msg.contains("index 4 out of range"), "{msg}");
+    let mtl = format!("{bom}newmtl lamp\rKe 1 1 1\rd nan\r");
+    let msg =
+        parse_error(load_from(&[("t.obj", obj.as_bytes()), ("l.mtl", mtl.as_bytes())], "t.obj"), "l.mtl", Some(3));
+    assert!(msg.contains("non-finite"), "{msg}");
 }
 
 #[test]

@@ -57,10 +57,12 @@ pub use stats::{
 pub use crate::geometry::TOLERANCE_REL;
 
 /// The absolute tolerance of the construction for `scene` over `octree`: [`TOLERANCE_REL`] times the
-/// larger of the scene's size and the octree's root cube. Every test that must agree with the builder
-/// (e.g. `plie inspect` telling a removed record from a face that cannot see the light) uses this.
+/// larger of the scene's size and the octree's root cube, or, for a scene far from the origin, the
+/// rounding of the root cube's coordinates ([`crate::geometry::tolerance_of`]). Every test that must
+/// agree with the builder (e.g. `plie inspect` telling a removed record from a face that cannot see
+/// the light) uses this.
 pub fn tolerance(scene: &Scene, octree: &Octree) -> f32 {
-    scene.scale().max(octree.root_bounds().size().max_element()) * TOLERANCE_REL
+    crate::geometry::tolerance_of(scene.scale().max(octree.root_bounds().size().max_element()), abs_scale(octree))
 }
 
 /// The largest absolute coordinate of `octree`'s root cube: the scale of the `f32` rounding the

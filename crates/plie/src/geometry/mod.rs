@@ -20,6 +20,6 @@ pub use dir::Dir;
 pub use polygon::newell;
 pub use ray_triangle::RayTest;
 pub use segment::Segment;
-pub use tolerance::{SEGMENT_EPS, TOLERANCE_REL};
+pub use tolerance::{tolerance_of, ROUNDING_REL, SEGMENT_EPS, TOLERANCE_REL};
 pub use tri_box::triangle_overlaps_box;
 pub use triangle::Triangle;

@@ -17,7 +17,8 @@
 //! Errors name the file and what is wrong (JSON syntax errors also the line). The `gltf` crate trusts
 //! accessor types and ranges (it panics or asserts on bad ones), so every accessor is checked first:
 //! type, count, stride and byte range within its buffer view and buffer. Sparse accessors, quantized
-//! (non-float) positions and point/line primitives are rejected with a clear error.
+//! (non-float) positions and point/line primitives are rejected with a clear error, as is a GLB whose
+//! header gives another length than the file's.
 
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
@@ -155,14 +156,16 @@ fn semantic_name(sem: &::gltf::json::validation::Checked<Semantic>) -> String {
 }
 
 /// The `gltf` crate subtracts the header size from the GLB's length field unchecked (an overflow
-/// panic in debug builds): check the header first.
+/// panic in debug builds) and ignores bytes after that length: check the header first. The length must
+/// be the file's: a longer one means the file is truncated, a shorter one that bytes were appended or
+/// the header is corrupt.
 fn check_glb_header(bytes: &[u8]) -> Result<(), String> {
     if !bytes.starts_with(b"glTF") {
         return Ok(());
     }
     let Some(length) = bytes.get(8..12) else { return Err("truncated GLB header".into()) };
     let length = u32::from_le_bytes([length[0], length[1], length[2], length[3]]);
-    if length < 20 || length as usize > bytes.len() {
+    if length < 20 || length as usize != bytes.len() {
         return Err(format!("GLB header says {length} bytes, but the file has {}", bytes.len()));
     }
     Ok(())

@@ -1,7 +1,8 @@
 //! MTL material libraries of OBJ scenes (SPEC §1), read with `tobj` through the checking line filter
 //! (`obj_lines.rs`): `newmtl`, `Kd`, `Ke` and `map_Kd`; what a renderer of the file would have shown
-//! and plie does not (a specular colour, a missing texture) is noted for the scene's warnings. See
-//! `obj.rs` for the whole format.
+//! and plie does not (a specular colour, a missing texture) is noted for the scene's warnings. Numbers
+//! that are not finite are errors in every statement that holds numbers (`Kd`, `Ke`, `Ns`, `d`, `Tr`, ...),
+//! also in those plie ignores. See `obj.rs` for the whole format.
 
 use std::cell::RefCell;
 use std::collections::HashSet;
@@ -11,7 +12,7 @@ use std::path::{Path, PathBuf};
 
 use glam::Vec3;
 
-use super::input::{open_regular, resolve_in_scene, LoadOptions, MAX_INPUT_BYTES};
+use super::input::{open_regular, resolve_in_scene, short, LoadOptions, MAX_INPUT_BYTES};
 use super::obj_lines::{parse_finite, rest_after_keyword, strip_comment, LineFilter, LineRules};
 use super::parse_error;
 use crate::error::Error;
@@ -38,8 +39,9 @@ pub(super) struct Libraries {
     pub(super) opts: LoadOptions,
 }
 
-/// Checks MTL lines: `newmtl` (recording the name), `Kd` and `Ke`; drops the rest, noting in `libs`
-/// what a renderer of the file would have shown (a specular colour, a texture).
+/// Checks MTL lines: `newmtl` (recording the name), `Kd` and `Ke`, and that numeric statements hold
+/// finite numbers; drops the rest, noting in `libs` what a renderer of the file would have shown (a
+/// specular colour, a texture).
 struct MtlRules<'a> {
     libs: &'a RefCell<Libraries>,
     /// The MTL file's directory (texture paths are relative to it).
@@ -54,11 +56,31 @@ impl MtlRules<'_> {
     }
 }
 
+/// True for MTL statements whose values are numbers (colours, exponents, dissolve, ...). plie reads `Kd`
+/// and `Ke` and drops the others, but a non-finite value (`d nan`, `Ns inf`, `Tr 1e39`) in any of them is
+/// an error, as in a vertex: the file is broken.
+fn is_numeric(keyword: &str) -> bool {
+    const NUMERIC: &str = "Ka Kd Ks Ke Kt Tf Ns Ni d Tr sharpness Pr Pm Ps Pc Pcr aniso anisor";
+    NUMERIC.split(' ').any(|k| k == keyword)
+}
+
+/// An error for the first word of a numeric statement's values that reads as a number but is not finite.
+/// Words that are not numbers (`Tf xyz ...`, `d -halo 0.5`) are left to the statement's own rules.
+fn check_finite<'a>(keyword: &str, mut values: impl Iterator<Item = &'a str>) -> Result<(), String> {
+    match values.find(|w| w.parse::<f32>().is_ok_and(|x| !x.is_finite())) {
+        Some(w) => Err(format!("{keyword} has a non-finite value '{}'", short(w))),
+        None => Ok(()),
+    }
+}
+
 impl LineRules for MtlRules<'_> {
     fn rewrite(&mut self, _line: usize, text: &str, out: &mut String) -> Result<(), String> {
         let text = strip_comment(text);
         let mut words = text.split_whitespace();
         let Some(keyword) = words.next() else { return Ok(()) };
+        if is_numeric(keyword) {
+            check_finite(keyword, words.clone())?;
+        }
         match keyword {
             "newmtl" => {
                 let name = rest_after_keyword(text, keyword);

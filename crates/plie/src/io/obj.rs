@@ -4,7 +4,7 @@
 //! What is read: `v` (with an optional `w`, which divides; vertex colours are ignored), `vt` (texture
 //! coordinates; a malformed one reads as (0, 0), as they were once ignored), `f` (polygons are
 //! fan-triangulated; positive and negative indices; texture indices are kept where every corner of the
-//! face has a valid one; normal indices are ignored), `o`/`g`, `mtllib` (paths relative to the OBJ;
+//! face has one; normal indices are only checked), `o`/`g`, `mtllib` (paths relative to the OBJ;
 //! several names on one line are allowed), `usemtl`, and in the MTL files `newmtl`, `Kd` (diffuse
 //! albedo, clamped to [0, 1]), `Ke` (emitted radiance) and `map_Kd` (a texture the albedo is multiplied
 //! by, issue 18: sRGB, bilinear, repeating; `v` flipped, since OBJ puts `v = 0` at the image's bottom;
@@ -18,8 +18,10 @@
 //!
 //! Faces before any `usemtl` get a grey default material (albedo 0.8). Everything that would make a
 //! scene silently differ from its file is an error naming the file and line: a `mtllib` that cannot be
-//! read, a `usemtl` naming a material no library defines, a malformed number, an index out of range, a
-//! non-finite coordinate, a face with fewer than 3 vertices, an empty file, a file without lights.
+//! read, a `usemtl` naming a material no library defines, a malformed number, a malformed or
+//! out-of-range index (vertex, texture coordinate or normal), a non-finite number (also in the MTL
+//! files), a face with fewer than 3 vertices, an empty file, a file without lights. Lines may end in
+//! `\n`, `\r\n` or a lone `\r`; a UTF-8 byte-order mark at the start is skipped (`obj_lines.rs`).
 
 use std::cell::RefCell;
 use std::collections::HashMap;
@@ -122,6 +124,8 @@ struct ObjRules<'a> {
     vertices: usize,
     /// Texture coordinates (`vt`) so far.
     texcoords: usize,
+    /// Normals (`vn`) so far: only counted, so that normal indices can be checked.
+    normals: usize,
     /// Geometry only (a mesh a Mitsuba scene names): `mtllib` and `usemtl` are dropped.
     mesh_only: bool,
     /// The line of every triangle `tobj` will produce, in order.
@@ -130,7 +134,7 @@ struct ObjRules<'a> {
 
 impl<'a> ObjRules<'a> {
     fn new(libs: &'a RefCell<Libraries>) -> Self {
-        ObjRules { libs, vertices: 0, texcoords: 0, mesh_only: false, tri_lines: Vec::new() }
+        ObjRules { libs, vertices: 0, texcoords: 0, normals: 0, mesh_only: false, tri_lines: Vec::new() }
     }
 
     fn vertex(&mut self, words: SplitWhitespace, out: &mut String) -> Result<(), String> {
@@ -183,26 +187,31 @@ impl<'a> ObjRules<'a> {
     }
 
     fn face(&mut self, line: usize, words: SplitWhitespace, out: &mut String) -> Result<(), String> {
-        let v = self.vertices as u64;
-        let t = self.texcoords as u64;
-        let resolve = |index: &str, n: u64, what: &str, token: &str| -> Result<u64, String> {
+        // (what the index names, how many of them are defined, their plural in messages)
+        let v = ("vertex", self.vertices as u64, "vertices");
+        let t = ("texture coordinate", self.texcoords as u64, "texture coordinates (vt)");
+        let vn = ("normal", self.normals as u64, "normals (vn)");
+        let resolve = |index: &str, (what, n, plural): (&str, u64, &str), token: &str| -> Result<u64, String> {
             let i: i64 = index.parse().map_err(|_| format!("malformed {what} index '{}' in a face", short(token)))?;
             match i {
                 0 => Err(format!("{what} index 0 in a face (OBJ indices start at 1)")),
                 i if i > 0 && i as u64 <= n => Ok(i as u64),
                 i if i < 0 && i.unsigned_abs() <= n => Ok(n + 1 - i.unsigned_abs()),
-                i => Err(format!("{what} index {i} out of range: {n} vertices are defined before this line")),
+                i => Err(format!("{what} index {i} out of range: {n} {plural} are defined before this line")),
             }
         };
         let mut corners: Vec<(u64, Option<u64>)> = Vec::new();
         for token in words {
             let mut parts = token.split('/');
-            let absolute = resolve(parts.next().unwrap_or(""), v, "vertex", token)?;
-            // A texture index that does not resolve leaves the face without texture coordinates.
+            let absolute = resolve(parts.next().unwrap_or(""), v, token)?;
             let uv = match parts.next() {
-                Some(s) if !s.is_empty() => resolve(s, t, "texture coordinate", token).ok(),
+                Some(s) if !s.is_empty() => Some(resolve(s, t, token)?),
                 _ => None,
             };
+            // Normals are not used, but an index naming none is as wrong as a vertex index.
+            if let Some(s) = parts.next().filter(|s| !s.is_empty()) {
+                resolve(s, vn, token)?;
+            }
             corners.push((absolute, uv));
         }
         // Texture indices only when every corner has one, so tobj's arrays stay parallel.
@@ -254,6 +263,10 @@ impl LineRules for ObjRules<'_> {
         match keyword {
             "v" => self.vertex(words, out),
             "vt" => self.texcoord(words, out),
+            "vn" => {
+                self.normals += 1;
+                Ok(())
+            }
             "usemtl" | "mtllib" if self.mesh_only => Ok(()),
             "f" => self.face(line, words, out),
             "usemtl" => self.usemtl(rest_after_keyword(text, keyword), out),

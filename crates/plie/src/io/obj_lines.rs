@@ -7,6 +7,9 @@
 //! the loader reports the filter's message and line instead of `tobj`'s. Lines plie does not need
 //! (normals, texture coordinates, other material parameters) become blank lines, so `tobj` never
 //! parses them and line numbers stay the same.
+//!
+//! Lines end in `\n`, `\r\n` or a lone `\r` (old Mac files), and a UTF-8 byte-order mark before the first
+//! line is skipped, so such files read like any other; `tobj` always gets `\n` line endings.
 
 use std::io::{self, BufRead, Read};
 
@@ -64,27 +67,22 @@ impl<R: BufRead, L: LineRules> LineFilter<R, L> {
             return Ok(());
         }
         self.raw.clear();
-        let n = match (&mut self.inner).take(MAX_LINE_BYTES + 1).read_until(b'\n', &mut self.raw) {
-            Ok(n) => n,
+        let complete = match read_line(&mut self.inner, &mut self.raw) {
+            Ok(Some(complete)) => complete,
+            Ok(None) => return Ok(()),
             Err(e) => {
                 self.line += 1;
                 return Err(self.fail(format!("read error: {e}")));
             }
         };
-        if n == 0 {
-            return Ok(());
-        }
         self.line += 1;
         if self.raw.len() as u64 > MAX_LINE_BYTES {
             return Err(self.fail(format!("the line is longer than the limit of {MAX_LINE_BYTES} bytes")));
         }
-        let complete = self.raw.last() == Some(&b'\n');
-        let mut end = self.raw.len() - usize::from(complete);
-        if end > 0 && self.raw[end - 1] == b'\r' {
-            end -= 1;
-        }
+        // A byte-order mark (written by some Windows editors) is not part of the first line's text.
+        let start = if self.line == 1 && self.raw.starts_with(BOM) { BOM.len() } else { 0 };
         let raw = std::mem::take(&mut self.raw);
-        let result = match std::str::from_utf8(&raw[..end]) {
+        let result = match std::str::from_utf8(&raw[start..]) {
             Ok(text) => self.rules.rewrite(self.line, text, &mut self.out),
             Err(_) => Err("the line is not valid UTF-8 text".to_string()),
         };
@@ -97,6 +95,55 @@ impl<R: BufRead, L: LineRules> LineFilter<R, L> {
         }
         self.out.push('\n');
         Ok(())
+    }
+}
+
+/// The UTF-8 byte-order mark.
+const BOM: &[u8] = b"\xEF\xBB\xBF";
+
+/// Reads one line of `inner` into `raw`, without its line ending: `\n`, `\r\n` or a lone `\r` (old Mac
+/// files). `Some(true)` if a line ending was read, `Some(false)` if the file ends in the line or the line
+/// is longer than [`MAX_LINE_BYTES`] (reading stops there), `None` at the end of the file.
+fn read_line(inner: &mut impl BufRead, raw: &mut Vec<u8>) -> io::Result<Option<bool>> {
+    let mut any = false;
+    loop {
+        let buf = match inner.fill_buf() {
+            Ok(buf) => buf,
+            Err(e) if e.kind() == io::ErrorKind::Interrupted => continue,
+            Err(e) => return Err(e),
+        };
+        if buf.is_empty() {
+            return Ok(any.then_some(false));
+        }
+        any = true;
+        let Some(i) = buf.iter().position(|&b| b == b'\n' || b == b'\r') else {
+            let n = buf.len();
+            raw.extend_from_slice(buf);
+            inner.consume(n);
+            if raw.len() as u64 > MAX_LINE_BYTES {
+                return Ok(Some(false));
+            }
+            continue;
+        };
+        let cr = buf[i] == b'\r';
+        raw.extend_from_slice(&buf[..i]);
+        inner.consume(i + 1);
+        if cr {
+            // `\r\n` is one line ending.
+            loop {
+                match inner.fill_buf() {
+                    Ok(next) => {
+                        if next.first() == Some(&b'\n') {
+                            inner.consume(1);
+                        }
+                        break;
+                    }
+                    Err(e) if e.kind() == io::ErrorKind::Interrupted => continue,
+                    Err(e) => return Err(e),
+                }
+            }
+        }
+        return Ok(Some(true));
     }
 }
 
@@ -171,6 +218,31 @@ mod tests {
         let lines: Vec<String> = (&mut f).lines().map(|l| l.unwrap()).collect();
         assert_eq!(lines, ["A", "B", "", "C"]);
         assert_eq!(f.line(), 4);
+    }
+
+    #[test]
+    fn lone_carriage_returns_end_lines() {
+        // Old Mac files end lines with `\r` alone; `\r\n` stays one line ending, also when the reader's
+        // buffer ends between the two bytes.
+        let text = b"a\rb\r\n\rc\r\nd\r";
+        let expected = ["A", "B", "", "C", "D"];
+        for capacity in [1, 2, 3, 64] {
+            let mut f = LineFilter::new(io::BufReader::with_capacity(capacity, &text[..]), Upper);
+            let lines: Vec<String> = (&mut f).lines().map(|l| l.unwrap()).collect();
+            assert_eq!(lines, expected, "buffer of {capacity} bytes");
+            assert_eq!(f.line(), 5);
+        }
+    }
+
+    #[test]
+    fn a_byte_order_mark_is_skipped() {
+        let mut f = LineFilter::new(&b"\xEF\xBB\xBFa\nb\n"[..], Upper);
+        let lines: Vec<String> = (&mut f).lines().map(|l| l.unwrap()).collect();
+        assert_eq!(lines, ["A", "B"]);
+        // Only at the start of the file.
+        let mut f = LineFilter::new(&b"a\n\xEF\xBB\xBFb\n"[..], Upper);
+        let lines: Vec<String> = (&mut f).lines().map(|l| l.unwrap()).collect();
+        assert_eq!(lines, ["A", "\u{FEFF}B"]);
     }
 
     #[test]

@@ -34,7 +34,7 @@ use crate::scene::Scene;
 /// First bytes of every `.plie` file.
 pub const MAGIC: [u8; 8] = *b"PLIE\r\n\x1a\n";
 /// Version of the layout written by this build of plie.
-pub const FORMAT_VERSION: u32 = 6;
+pub const FORMAT_VERSION: u32 = 7;
 const HEADER: usize = 8 + 4 + 8 + 8;
 
 /// What a `.plie` file holds after its header.

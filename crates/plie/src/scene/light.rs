@@ -237,31 +237,37 @@ mod tests {
     }
 
     /// A light flat and convex only up to its corners' rounding is accepted where that is within
-    /// the scene's tolerance, and refused with a clear error where it is not.
+    /// the scene's tolerance, which far from the origin grows with the coordinates
+    /// ([`crate::geometry::tolerance_of`]); one that `Light::new` accepts for that rounding but that
+    /// lies further from a flat convex polygon than the scene's tolerance is refused with a clear
+    /// error.
     #[test]
     fn rounding_of_a_light_within_the_scene_tolerance() {
-        let scene = |at: Vec3, k: usize| {
-            let a = k as f32 * 0.37;
-            let rot = glam::Mat3::from_euler(glam::EulerRot::XYZ, a, a * 1.7, a * 2.3);
+        let scene = |at: Vec3, corners: &[Vec3]| {
             let mut b = crate::scene::SceneBuilder::new("far");
             let w = b.diffuse("w", Vec3::splat(0.5));
             b.triangle(at, at + Vec3::X, at + Vec3::Z, w);
-            let quad: Vec<Vec3> = [(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)]
-                .iter()
-                .map(|&(u, v)| at + Vec3::Y + rot * Vec3::new(u * 0.01, v * 0.01, 0.0))
-                .collect();
-            b.light("l", &quad, Vec3::ONE);
+            let poly: Vec<Vec3> = corners.iter().map(|&c| at + Vec3::Y + c).collect();
+            b.light("l", &poly, Vec3::ONE);
             b.build()
         };
-        let mut refused = 0;
         for k in 0..50 {
-            assert!(scene(Vec3::new(30.0, 50.0, 20.0), k).is_ok(), "turn {k}");
-            if let Err(e) = scene(Vec3::splat(5000.0), k) {
-                assert!(e.to_string().contains("too small for its distance from the origin"), "{e}");
-                refused += 1;
+            let a = k as f32 * 0.37;
+            let rot = glam::Mat3::from_euler(glam::EulerRot::XYZ, a, a * 1.7, a * 2.3);
+            let quad: Vec<Vec3> = [(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)]
+                .map(|(u, v)| rot * Vec3::new(u * 0.01, v * 0.01, 0.0))
+                .into();
+            for at in [Vec3::new(30.0, 50.0, 20.0), Vec3::splat(5000.0)] {
+                assert!(scene(at, &quad).is_ok(), "turn {k} at {at}");
             }
         }
-        assert!(refused > 10, "{refused} of 50 refused");
+        // Flat, but with a corner pushed in by 0.04: within what `Light::new` allows for rounding
+        // 5000 units out, not within this scene's tolerance (its size is about 1).
+        let dented: Vec<Vec3> = [(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.2, 1.0), (0.1, 0.96), (0.0, 1.0)]
+            .map(|(x, z)| Vec3::new(x, 0.0, z))
+            .into();
+        let e = scene(Vec3::splat(5000.0), &dented).expect_err("a dented light");
+        assert!(e.to_string().contains("too small for its distance from the origin"), "{e}");
     }
 
     #[test]

@@ -4,6 +4,7 @@
 
 pub mod builtin;
 pub mod camera;
+mod dropped;
 pub mod ids;
 pub mod light;
 pub mod material;

@@ -46,15 +46,16 @@ pub enum Filter {
 pub enum Texels {
     /// 8 bits per channel (`r, g, b` per texel) and the linear value of each of the 256 codes.
     Rgb8 {
-        /// The codes, three per texel.
-        codes: Vec<u8>,
+        /// The codes, three per texel; shared by the texels of one file read as sRGB colour and as
+        /// raw values, which differ in their table only.
+        codes: Arc<Vec<u8>>,
         /// The linear value of each code.
         table: Box<[f32; 256]>,
     },
     /// 16 bits per channel (`r, g, b` per texel) and the linear value of each of the 65,536 codes.
     Rgb16 {
-        /// The codes, three per texel.
-        codes: Vec<u16>,
+        /// The codes, three per texel; shared as for [`Texels::Rgb8`].
+        codes: Arc<Vec<u16>>,
         /// The linear value of each code.
         table: Box<[f32; 65536]>,
     },
@@ -98,7 +99,7 @@ impl Texels {
         (0..self.len()).map(|i| self.get(i))
     }
 
-    /// Bytes held, tables included.
+    /// Bytes held, tables included (and the codes, even where shared with other texels).
     pub fn bytes(&self) -> usize {
         match self {
             Texels::Rgb8 { codes, .. } => codes.len() + 256 * 4,

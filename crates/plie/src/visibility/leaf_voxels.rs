@@ -148,7 +148,7 @@ mod tests {
     fn voxels_visit_every_triangle_hit_inside_the_leaf() {
         let scene = crate::scene::builtin::load("huis-a").unwrap();
         let octree = Octree::build(&scene, crate::octree::OctreeParams::thesis()).expect("valid octree parameters");
-        let pad = scene.scale() * crate::construct::TOLERANCE_REL;
+        let pad = scene.tolerance();
         let boxes: Vec<Aabb> = scene.triangles.iter().map(|t| t.aabb().expanded(pad)).collect();
         let vox = LeafVoxels::new(&octree, &boxes, pad);
         assert!(vox.first.iter().any(|&f| f != u32::MAX), "some leaf has a grid");

@@ -6,7 +6,7 @@
 
 use glam::{Vec3, Vec4};
 
-use crate::geometry::{Aabb, Triangle, TOLERANCE_REL};
+use crate::geometry::{Aabb, Triangle};
 use crate::scene::{Light, LightId, Scene};
 use crate::visibility::simd::Avx2;
 
@@ -62,9 +62,11 @@ pub struct PyramidBasis {
 }
 
 /// The margin every per-light query grows its pyramid by: ten times the scene's tolerance
-/// ([`TOLERANCE_REL`] of its size).
+/// ([`Scene::tolerance`]: [`crate::geometry::TOLERANCE_REL`] of its size, or the rounding of its
+/// coordinates where that is larger, so that a light's samples, rounded off its tilted plane far
+/// from the origin, stay inside).
 pub fn margin_of(scene: &Scene) -> f32 {
-    scene.scale() * TOLERANCE_REL * 10.0
+    scene.tolerance() * 10.0
 }
 
 impl PyramidBasis {

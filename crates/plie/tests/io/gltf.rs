@@ -219,6 +219,24 @@ fn binary_glb() {
 }
 
 #[test]
+fn glb_length_must_be_the_files() {
+    let bytes = glb_file();
+    let n = bytes.len();
+    // Bytes after the GLB's end were ignored; now they are an error, as a truncated file is.
+    let mut longer = bytes.clone();
+    longer.extend([0u8; 4]);
+    let msg = parse_error(load_from(&[("s.glb", &longer)], "s.glb"), "s.glb", None);
+    assert!(msg.contains(&format!("GLB header says {n} bytes, but the file has {}", n + 4)), "{msg}");
+    let mut header = bytes.clone();
+    header[8..12].copy_from_slice(&(n as u32 - 4).to_le_bytes());
+    let msg = parse_error(load_from(&[("s.glb", &header)], "s.glb"), "s.glb", None);
+    assert!(msg.contains(&format!("GLB header says {} bytes, but the file has {n}", n - 4)), "{msg}");
+    header[8..12].copy_from_slice(&(n as u32 + 4).to_le_bytes());
+    let msg = parse_error(load_from(&[("s.glb", &header)], "s.glb"), "s.glb", None);
+    assert!(msg.contains(&format!("GLB header says {} bytes, but the file has {n}", n + 4)), "{msg}");
+}
+
+#[test]
 fn inputs_the_gltf_crate_would_panic_on() {
     // A GLB length field smaller than the header underflows inside the crate.
     let mut bytes = glb_file();

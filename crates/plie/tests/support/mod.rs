@@ -126,6 +126,47 @@ impl Built {
     }
 }
 
+/// Brute force and every other exact mode over one built scene, to compare their answers.
+pub struct ExactModes<'a> {
+    brute: Box<dyn plie::visibility::Visibility + 'a>,
+    modes: Vec<(plie::visibility::Mode, Box<dyn plie::visibility::Visibility + 'a>)>,
+    out: Vec<bool>,
+}
+
+impl<'a> ExactModes<'a> {
+    pub fn new(built: &'a Built, scene: &'a Scene) -> ExactModes<'a> {
+        use plie::visibility::Mode;
+        let modes = Mode::EXACT.into_iter().filter(|&m| m != Mode::Brute).map(|m| (m, built.vis(scene, m))).collect();
+        ExactModes { brute: built.vis(scene, Mode::Brute), modes, out: Vec::new() }
+    }
+
+    /// Asserts that every exact mode answers each sample of `q`, ray by ray and per light, as brute
+    /// force does (`what` names the case); returns how many brute force found occluded.
+    pub fn check(
+        &mut self,
+        what: &str,
+        q: &plie::visibility::LightRays,
+        ctx: &mut plie::visibility::QueryCtx,
+    ) -> usize {
+        let n = q.targets.len();
+        let reference: Vec<bool> = (0..n).map(|k| self.brute.occluded(&q.ray(k), ctx)).collect();
+        for (mode, vis) in &self.modes {
+            self.out.clear();
+            self.out.resize(n, false);
+            vis.occluded_light(q, &mut self.out, ctx);
+            for (k, (&brute, &per_light)) in reference.iter().zip(&self.out).enumerate() {
+                let ray: ShadowRay = q.ray(k);
+                let per_ray = vis.occluded(&ray, ctx);
+                assert!(
+                    per_ray == brute && per_light == brute,
+                    "{what}: {mode}: per-ray {per_ray}, per-light {per_light}, brute force {brute} for {ray:?}",
+                );
+            }
+        }
+        reference.iter().filter(|&&b| b).count()
+    }
+}
+
 /// The construction (stages 1-7) on a given octree, without limits: what the tests that compare
 /// builds on one octree need (users call [`plie::Environment::build`]).
 pub fn construct(

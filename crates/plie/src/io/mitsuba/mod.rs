@@ -95,7 +95,6 @@ fn load_within(path: &Path, opts: LoadOptions, max_triangles: usize) -> Result<S
         triangles: 0,
         max_triangles,
         loaded: (0, 0),
-        degenerate: 0,
         camera: false,
     };
     for e in &doc.root.children {
@@ -177,9 +176,6 @@ struct Loader<'a> {
     /// Vertices and triangles of the distinct mesh files read (kept in [`Loader::meshes`]), bounded
     /// like the expanded scene: at most `max_triangles` triangles and three vertices a triangle.
     loaded: (usize, usize),
-    /// Triangles naming a vertex twice, left out (see [`Loader::add_mesh`]) and added to
-    /// [`Scene::degenerate_skipped`].
-    degenerate: usize,
     camera: bool,
 }
 
@@ -333,19 +329,10 @@ impl<'a> Loader<'a> {
         // Vertices are placed as triangles use them, not copied all at once: a mesh may declare
         // many more vertices than its triangles use (150 million from a 2 MB serialized file).
         let place = |i: u32| to_world.transform_point3(mesh.positions[i as usize]);
-        let emits = radiance.is_some_and(|r| r.max_element() > 0.0);
         for t in &mesh.triangles {
             let placed = t.map(place);
             if placed.iter().any(|v| !v.is_finite()) {
                 return Err(e.error("a transformed vertex is not finite".into()));
-            }
-            // A triangle naming a vertex twice has zero area wherever it is placed: the builder
-            // would drop it (and count it) anyway, so it is counted here without taking the
-            // builder's memory (a small zlib stream can hold millions). Emissive and textured ones
-            // go to the builder as before, which reports them exactly as it did.
-            if !emits && !textured && (t[0] == t[1] || t[1] == t[2] || t[0] == t[2]) {
-                self.degenerate += 1;
-                continue;
             }
             let (t, v) = if flip { ([t[0], t[2], t[1]], [placed[0], placed[2], placed[1]]) } else { (*t, placed) };
             let id = if textured {
@@ -549,7 +536,6 @@ impl<'a> Loader<'a> {
             e => e,
         })?;
         scene.warnings = warnings;
-        scene.degenerate_skipped += self.degenerate;
         Ok(scene)
     }
 }

@@ -401,7 +401,7 @@ mod tests {
             let p = lo + size * Vec3::new(rnd(), rnd(), rnd());
             let b = Aabb { min: p, max: p + size * (0.02 + 0.2 * rnd()) };
             let light = &scene.lights[(rnd() * scene.lights.len() as f32) as usize % scene.lights.len()].vertices;
-            let pad = scene.scale() * 1e-5;
+            let pad = scene.tolerance();
             let cut = bvh.cut_of(&b, light, pad);
             // The hull, to check against.
             let corners = b.corners();
@@ -462,7 +462,7 @@ mod tests {
             let b = Aabb { min: p, max: p + size * (0.01 + 0.1 * rnd()) };
             let li = (rnd() * scene.lights.len() as f32) as usize % scene.lights.len();
             let light = &scene.lights[li];
-            let cut = bvh.cut_of(&b, &light.vertices, scene.scale() * 1e-5);
+            let cut = bvh.cut_of(&b, &light.vertices, scene.tolerance());
             let x = b.min + (b.max - b.min) * Vec3::new(rnd(), rnd(), rnd());
             let v = &light.vertices;
             let targets: Vec<Vec3> = (0..32)

@@ -138,7 +138,7 @@ impl LieVisibility<'_> {
         } else {
             ctx.stats.lights.scene += 1;
             // The cut holds every triangle a segment from the leaf to the light can meet.
-            debug_assert!(self.octree.leaf_bounds(leaf).expanded(self.scene.scale() * 1e-5).contains(rays.origin));
+            debug_assert!(self.octree.leaf_bounds(leaf).expanded(self.scene.tolerance()).contains(rays.origin));
             let cut = self.cut(leaf, rays.light);
             self.bvh.fan_occluded(cut, rays, &mut sc.fan, &mut sc.walk, out, ctx);
         }

@@ -94,7 +94,7 @@ impl<'a> LieVisibility<'a> {
     /// built for `scene` and `octree`. Without regions or grids in the P-LIE, the modes that use them
     /// test the blockers instead (still exact).
     pub fn new(scene: &'a Scene, bvh: &'a Bvh, octree: &'a Octree, plie: &'a Plie, mode: Mode) -> LieVisibility<'a> {
-        let pad = scene.scale() * crate::geometry::TOLERANCE_REL;
+        let pad = scene.tolerance();
         let tri_boxes: Vec<Aabb> = scene.triangles.iter().map(|t| t.aabb().expanded(pad)).collect();
         let voxels = LeafVoxels::new(octree, &tri_boxes, pad);
         let records = plie.records.iter().map(|r| (r.blockers_start, r.blockers_len));
