@@ -19,7 +19,9 @@
 //! 1.5 s and a depth of 713; 20,000 glTF instances: 70 s): PLOC orders boxes by the Morton code of
 //! their centres and cannot order equal codes. So more than [`CROWD_LIMIT`] boxes whose centres share
 //! a Morton cell become one primitive listing their triangles (`crowd.rs`); ordinary scenes have no
-//! such crowd and keep one primitive per triangle.
+//! such crowd and keep one primitive per triangle. Boxes along which PLOC's merge costs change
+//! steadily (a fan of triangles around one centre across the scene: 100,000 took 15 s) stall it too;
+//! where its first choices pair up too few boxes, the BVH is split top-down instead (`top_down.rs`).
 //!
 //! The fans' walks (`fan_walk.rs`) read a leaf's triangles from a copy laid out in the order of the
 //! leaves (`LeafTris`: 48 bytes a triangle with its id and light), so that they lie side by side in
@@ -45,6 +47,7 @@ mod collect;
 mod crowd;
 mod cut;
 mod fan_walk;
+mod top_down;
 
 pub(crate) use cut::Cut;
 
@@ -319,16 +322,21 @@ fn segment_occluded_with<S: FastStack<UVec2>, P: Prims>(
 }
 
 /// obvhs' `build_cwbvh` (PLOC, reinsertion, conversion to BVH8) without its debug-build `validate`,
-/// which asserts that the depth fits obvhs' fixed stack: here a deeper BVH is valid ([`Walk`]).
+/// which asserts that the depth fits obvhs' fixed stack: here a deeper BVH is valid ([`Walk`]). Where
+/// PLOC would stall ([`top_down::ploc_would_stall`]), a top-down build takes its place.
 fn build_cwbvh(boxes: &[BAabb], config: BvhBuildParams) -> CwBvh {
-    let indices = (0..boxes.len() as u32).collect::<Vec<_>>();
-    let mut bvh2 = PlocBuilder::with_capacity(boxes.len()).build(
-        config.ploc_search_distance,
-        boxes,
-        indices,
-        config.sort_precision,
-        config.search_depth_threshold,
-    );
+    let mut bvh2 = if top_down::ploc_would_stall(boxes) {
+        top_down::build(boxes)
+    } else {
+        let indices = (0..boxes.len() as u32).collect::<Vec<_>>();
+        PlocBuilder::with_capacity(boxes.len()).build(
+            config.ploc_search_distance,
+            boxes,
+            indices,
+            config.sort_precision,
+            config.search_depth_threshold,
+        )
+    };
     ReinsertionOptimizer::default().run(&mut bvh2, config.reinsertion_batch_ratio, None);
     bvh2_to_cwbvh(&bvh2, config.max_prims_per_leaf.clamp(1, 3), true, false)
 }
