@@ -68,7 +68,7 @@ pub fn tolerance(scene: &Scene, octree: &Octree) -> f32 {
 /// The largest absolute coordinate of `octree`'s root cube: the scale of the `f32` rounding the
 /// regions and propagation allow for.
 pub(crate) fn abs_scale(octree: &Octree) -> f32 {
-    octree.root_bounds().min.abs().max(octree.root_bounds().max.abs()).max_element()
+    octree.root_bounds().largest_abs()
 }
 
 /// The construction was interrupted ([`Progress::cancelled`]); nothing was built.

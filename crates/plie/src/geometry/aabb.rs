@@ -71,6 +71,12 @@ impl Aabb {
         self.size().length()
     }
 
+    /// The largest absolute coordinate of the box: how far it reaches from the origin along an
+    /// axis, the scale of the `f32` rounding of points in it.
+    pub fn largest_abs(&self) -> f32 {
+        self.min.abs().max(self.max.abs()).max_element()
+    }
+
     /// Closed-box containment.
     pub fn contains(&self, p: Vec3) -> bool {
         p.cmpge(self.min).all() && p.cmple(self.max).all()

@@ -39,9 +39,7 @@ const PAR_CHUNK: usize = 4096;
 /// for a scene far from the origin it stays several `f32` ulps of its coordinates wide, so rounding in
 /// the traversal can never close the margin.
 pub fn tolerance(scene: &Scene) -> f32 {
-    let b = scene.bounds;
-    let far = b.min.abs().max(b.max.abs()).max_element();
-    EPS_REL * scene.scale().max(far)
+    EPS_REL * scene.scale().max(scene.bounds.largest_abs())
 }
 
 /// The root cube for a scene and tolerance.

@@ -96,7 +96,7 @@ impl Scene {
     /// The scene's absolute tolerance ([`crate::geometry::tolerance_of`]): `1e-5` of its size, or
     /// for a scene far from the origin, the rounding of its coordinates to `f32` with room to spare.
     pub fn tolerance(&self) -> f32 {
-        crate::geometry::tolerance_of(self.scale(), far_of(&self.bounds))
+        crate::geometry::tolerance_of(self.scale(), self.bounds.largest_abs())
     }
 }
 
@@ -273,7 +273,7 @@ impl SceneBuilder {
         // per-light queries grow their pyramids by (ten tolerances, [`Scene::tolerance`]), so that
         // its samples stay inside that pyramid; a light within `1e-4` of its own size is so in any
         // scene holding it.
-        let tol = 2.5 * crate::geometry::tolerance_of(bounds.size().max_element(), far_of(&bounds));
+        let tol = 2.5 * crate::geometry::tolerance_of(bounds.size().max_element(), bounds.largest_abs());
         for (li, l) in lights.iter().enumerate() {
             let dev = l.deviation();
             if dev > tol.max(1e-4 * l.size()) {
@@ -361,11 +361,6 @@ impl SceneBuilder {
         }
         Ok((lights, tri_light))
     }
-}
-
-/// The largest absolute coordinate of `b`.
-fn far_of(b: &Aabb) -> f32 {
-    b.min.abs().max(b.max.abs()).max_element()
 }
 
 #[cfg(test)]

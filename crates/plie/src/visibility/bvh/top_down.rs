@@ -63,7 +63,7 @@ pub(super) fn ploc_would_stall(boxes: &[BAabb]) -> bool {
     (0..n).step_by(WINDOW).any(|start| {
         let end = (start + WINDOW).min(n);
         let paired = (start..end).filter(|&k| choice[choice[k]] == k).count();
-        // A last stretch too short to judge is judged with the one before it.
+        // A last stretch shorter than half a window is too short to judge, and is not judged.
         end - start >= WINDOW / 2 && paired * STALL < end - start
     })
 }

@@ -40,8 +40,7 @@ unsafe impl Sync for ExactEmbree {}
 /// How far every triangle box is grown: `1e-5` of the scene size, plus a few ulps of the largest
 /// coordinate so scenes far from the origin are padded too.
 fn pad(scene: &Scene) -> f32 {
-    let far = scene.bounds.min.abs().max(scene.bounds.max.abs()).max_element();
-    scene.scale() * 1e-5 + far * 4.0 * f32::EPSILON
+    scene.scale() * 1e-5 + scene.bounds.largest_abs() * 4.0 * f32::EPSILON
 }
 
 impl ExactEmbree {
