@@ -7,11 +7,10 @@
 //! test ([`triangle_overlaps_box`]); a cheap bounding-box pre-filter with a `2 eps` slack only skips
 //! children the exact test would reject too.
 //!
-//! Exact copies of a triangle (the same three vertices, in any order) count once toward
-//! `max_triangles`: no split can ever separate them, so a cell with more than `max_triangles`
-//! triangles but few distinct ones would split to `max_depth` wherever the copies lie. A face line
-//! `f 1 2 3 1 2 3 ...` adding 200 copies of the Cornell box's floor triangle made 1,220,836 leaves
-//! that way; counting distinct triangles the split stops as soon as it could not reduce the count.
+//! Triangles no split can separate count once toward `max_triangles` (`hubs`): exact copies
+//! of a triangle, and the triangles sharing a vertex of the cell that more than `max_triangles` of
+//! them share (a hub). Otherwise a cell holding them would split to `max_depth`, and for a hub the
+//! cells around it too.
 //!
 //! The build runs level by level. For one level, the cells to split are split in parallel (rayon,
 //! and large triangle lists in parallel chunks); the results are then placed into the flat arrays by
@@ -21,6 +20,7 @@
 
 use rayon::prelude::*;
 
+use super::hubs::SplitCount;
 use super::{child_box, Leaf, LeafId, Node, Octree, OctreeParams};
 use crate::geometry::{triangle_overlaps_box, Aabb};
 use crate::scene::{Scene, TriId};
@@ -87,7 +87,7 @@ impl Octree {
             scene_triangles: n,
             capped: false,
         };
-        let first_copy = first_copies(scene);
+        let count = SplitCount::new(scene, params.max_triangles);
         let all = (0..n as u32).map(TriId).collect();
         let mut frontier = vec![Pending { node: 0, bounds: root, depth: 0, tris: all }];
         let max_nodes = super::max_nodes(n);
@@ -98,7 +98,7 @@ impl Octree {
                     p.depth == 0
                         || (p.depth < params.max_depth
                             && p.tris.len() > params.max_triangles
-                            && distinct(&p.tris, &first_copy) > params.max_triangles)
+                            && count.groups(scene, &p.tris, &p.bounds.expanded(eps)) > params.max_triangles)
                 })
                 .collect();
             // A level whose splits would pass the node cap splits nothing but the root (the same
@@ -167,26 +167,6 @@ impl Octree {
         self.leaves.push(Leaf { node, depth, start, end: self.leaf_tris.len() as u32 });
         self.depth = self.depth.max(depth);
     }
-}
-
-/// For every triangle, whether it is the first of its exact copies (the same vertices, in any order,
-/// compared bit for bit). Copies overlap the same cells, so a cell holding a copy holds its first.
-fn first_copies(scene: &Scene) -> Vec<bool> {
-    let mut seen = std::collections::HashSet::with_capacity(scene.triangles.len());
-    scene
-        .triangles
-        .iter()
-        .map(|t| {
-            let mut key = t.v.map(|v| v.to_array().map(f32::to_bits));
-            key.sort_unstable();
-            seen.insert(key)
-        })
-        .collect()
-}
-
-/// The number of distinct triangles of a cell (exact copies counted once).
-fn distinct(tris: &[TriId], first_copy: &[bool]) -> usize {
-    tris.iter().filter(|t| first_copy[t.idx()]).count()
 }
 
 /// Distributes a cell's triangles over its 8 children (each list keeps the parent's order).
@@ -262,14 +242,18 @@ mod tests {
         assert_eq!(size.y, size.z);
     }
 
-    /// A quad's two triangles with leaves of one triangle down to depth 16 would split along their
-    /// shared edge to over a million nodes; the node cap stops the build at a level, the same for
-    /// any thread count, and the octree stays valid.
+    /// Four triangles crossing each other, with leaves of one triangle down to depth 16, would split
+    /// along the lines where they cross to over a million nodes; the node cap stops the build at a
+    /// level, the same for any thread count, and the octree stays valid. (Along a shared edge the
+    /// shared vertices would be hubs at this limit: `hubs`.)
     #[test]
     fn the_node_cap_bounds_an_octree_that_would_split_without_end() {
-        let mut b = SceneBuilder::new("quad");
+        let mut b = SceneBuilder::new("crossing");
         let m = b.diffuse("grey", Vec3::splat(0.5));
-        b.quad(Vec3::ZERO, Vec3::Z, Vec3::new(1.0, 0.0, 1.0), Vec3::X, m);
+        b.triangle(Vec3::new(-0.1, 0.0, -0.1), Vec3::new(0.3, 0.0, 1.1), Vec3::new(1.1, 0.0, 0.2), m);
+        b.triangle(Vec3::new(0.1, -0.5, 0.13), Vec3::new(0.9, 0.4, 0.85), Vec3::new(0.95, -0.6, 0.9), m);
+        b.triangle(Vec3::new(0.52, -0.7, -0.2), Vec3::new(0.52, 0.6, 0.3), Vec3::new(0.52, -0.3, 1.2), m);
+        b.triangle(Vec3::new(-0.2, -0.6, 0.47), Vec3::new(1.2, -0.4, 0.47), Vec3::new(0.4, 0.7, 0.47), m);
         b.light("light", &[Vec3::new(0.0, 2.0, 0.0), Vec3::new(0.1, 2.0, 0.0), Vec3::new(0.1, 2.0, 0.1)], Vec3::ONE);
         let s = b.build().expect("valid scene");
         let params = OctreeParams { max_triangles: 1, max_depth: 16 };
@@ -286,22 +270,50 @@ mod tests {
         assert!(!small.capped);
     }
 
-    #[test]
-    fn splits_until_limit_or_depth() {
+    /// 30 thin triangles sharing a vertex (they all meet in every cell around it) and a floor of
+    /// `floor` x `floor` squares around them, far enough that some cells hold no hub.
+    fn spokes(floor: usize) -> Scene {
         let mut b = SceneBuilder::new("fan");
         let m = b.diffuse("grey", Vec3::splat(0.5));
-        // 30 thin triangles sharing a vertex: they all meet in every cell around it.
         for i in 0..30 {
             let a = i as f32 * 0.2;
             b.triangle(Vec3::ZERO, Vec3::new(a.cos(), a.sin(), 0.1), Vec3::new(a.cos(), a.sin(), -0.1), m);
         }
-        b.light("light", &[Vec3::new(0.0, 2.0, 0.0), Vec3::new(0.1, 2.0, 0.0), Vec3::new(0.1, 2.0, 0.1)], Vec3::ONE);
-        let s = b.build().expect("valid scene");
-        let o = Octree::build(&s, OctreeParams { max_triangles: 4, max_depth: 5 }).expect("valid octree parameters");
-        assert_eq!(o.depth(), 5, "the shared vertex forces splitting to max_depth");
-        for l in o.leaves() {
-            assert!(o.leaf_triangles(l).len() <= 4 || o.leaf_depth(l) == 5);
+        let p = |i: usize, j: usize| Vec3::new(1.5 + i as f32 * 0.3, -1.0, 1.5 + j as f32 * 0.3);
+        for i in 0..floor {
+            for j in 0..floor {
+                b.quad(p(i, j), p(i, j + 1), p(i + 1, j + 1), p(i + 1, j), m);
+            }
         }
+        b.light("light", &[Vec3::new(0.0, 2.0, 0.0), Vec3::new(0.1, 2.0, 0.0), Vec3::new(0.1, 2.0, 0.1)], Vec3::ONE);
+        b.build().expect("valid scene")
+    }
+
+    #[test]
+    fn splits_until_limit_or_depth_but_not_around_a_hub() {
+        let s = spokes(12);
+        // The floor's vertices are shared by at most 6 triangles: no hubs at a limit of 6.
+        let o = Octree::build(&s, OctreeParams { max_triangles: 6, max_depth: 5 }).expect("valid octree parameters");
+        assert!(o.validate(&s).is_ok());
+        assert_eq!(o.depth(), 5, "the floor splits to max_depth");
+        let mut hub_leaves = 0;
+        for l in o.leaves() {
+            let grown = o.node_bounds[o.leaves[l.idx()].node as usize].expanded(o.eps);
+            let tris = o.leaf_triangles(l);
+            if grown.contains(Vec3::ZERO) {
+                // The hub's 30 triangles and at most 5 others, in a cell no deeper than needed.
+                hub_leaves += 1;
+                assert!(
+                    (30..=35).contains(&tris.len()) && o.leaf_depth(l) < 5,
+                    "{} at {}",
+                    tris.len(),
+                    o.leaf_depth(l)
+                );
+            } else {
+                assert!(tris.len() <= 6 || o.leaf_depth(l) == 5, "{} at {}", tris.len(), o.leaf_depth(l));
+            }
+        }
+        assert!(hub_leaves > 0);
     }
 
     /// A unit floor (two triangles) with `copies` more copies of its first triangle (vertices in
@@ -345,7 +357,7 @@ mod tests {
         assert!(o.depth() > 1 && o.leaf_count() < 4096, "{} leaves, depth {}", o.leaf_count(), o.depth());
         for l in o.leaves() {
             let tris = o.leaf_triangles(l);
-            let d = distinct(tris, &first_copies(&s));
+            let d = SplitCount::new(&s, 2).distinct(tris);
             assert!(d <= 2 || o.leaf_depth(l) == 10, "leaf with {d} distinct triangles above max_depth");
         }
     }

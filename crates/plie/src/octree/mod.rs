@@ -19,11 +19,12 @@
 //!   leaf triangle lists. Each list is sorted by ascending [`TriId`]. Leaves are numbered breadth-first
 //!   (after [`refine`], the children of split leaves follow the others).
 //!
-//! Stages: [`build`] (construction), [`locate`] (point location), [`traverse`] (segments and boxes),
-//! [`neighbour`] (face, edge and corner neighbours), [`refine`] (splitting chosen leaves, §4.8),
-//! [`validate`] (invariant report).
+//! Stages: [`build`] (construction, with `hubs` saying when a split can separate triangles),
+//! [`locate`] (point location), [`traverse`] (segments and boxes), [`neighbour`] (face, edge and
+//! corner neighbours), [`refine`] (splitting chosen leaves, §4.8), [`validate`] (invariant report).
 
 pub mod build;
+mod hubs;
 pub mod locate;
 pub mod neighbour;
 pub mod refine;

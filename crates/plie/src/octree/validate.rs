@@ -6,7 +6,8 @@
 //!   once from the root, root split, stored boxes equal to the boxes recomputed top-down, stored depths right;
 //! - ranges: every leaf's range lies in the flat list, ranges are disjoint and cover it, triangle ids
 //!   exist and each list is strictly ascending;
-//! - size: no leaf over `max_triangles` unless at `max_depth` (or the node cap stopped the build);
+//! - size: no leaf over `max_triangles` unless at `max_depth` (or the node cap stopped the build), exact
+//!   copies and the triangles around a hub counted once as the build counts them (`hubs`);
 //! - assignment: for every triangle, the leaves it is listed in are exactly the leaves whose box grown
 //!   by `eps` it overlaps by [`triangle_overlaps_box`]. Candidates come from
 //!   [`Octree::for_each_leaf_overlapping`] on the triangle's bounding box, so the check costs about
@@ -16,6 +17,7 @@ use std::fmt;
 
 use rayon::prelude::*;
 
+use super::hubs::SplitCount;
 use super::{child_box, LeafId, NodeKind, Octree};
 use crate::geometry::triangle_overlaps_box;
 use crate::scene::{Scene, TriId};
@@ -154,11 +156,11 @@ impl Octree {
         }
         self.check_structure(&mut v);
         self.check_ranges(scene, &mut v);
-        // The assignment check needs sound lists and links.
+        // The assignment and size checks need sound lists and links.
         if v.is_empty() {
             v.extend(self.check_assignment(scene));
+            self.check_sizes(scene, &mut v);
         }
-        self.check_sizes(&mut v);
         // From the ranges alone: they may be broken.
         let sizes = self.leaves.iter().map(|l| l.end.saturating_sub(l.start) as usize);
         let violation_count = v.len();
@@ -267,11 +269,19 @@ impl Octree {
         }
     }
 
-    fn check_sizes(&self, v: &mut Vec<Violation>) {
+    /// Sizes need sound ranges: called only when they are.
+    fn check_sizes(&self, scene: &Scene, v: &mut Vec<Violation>) {
+        let mut count = None;
         for (i, leaf) in self.leaves.iter().enumerate() {
             let n = leaf.end.saturating_sub(leaf.start) as usize;
             if n > self.params.max_triangles && leaf.depth < self.params.max_depth && !self.capped {
-                v.push(Violation::Overfull { leaf: LeafId(i as u32), triangles: n, depth: leaf.depth });
+                // Copies and hubs count once (`hubs`): such a leaf is full only if the rest is.
+                let count = count.get_or_insert_with(|| SplitCount::new(scene, self.params.max_triangles));
+                let list = &self.leaf_tris[leaf.start as usize..leaf.end as usize];
+                let grown = self.node_bounds[leaf.node as usize].expanded(self.eps);
+                if count.groups(scene, list, &grown) > self.params.max_triangles {
+                    v.push(Violation::Overfull { leaf: LeafId(i as u32), triangles: n, depth: leaf.depth });
+                }
             }
         }
     }
