@@ -44,7 +44,7 @@ fn every_mode_matches_brute_force_over_a_fan_of_20000_triangles() {
     b.light("l", &light, Vec3::ONE);
     let scene = b.build().expect("a valid scene");
     // The centre is a hub (`octree/hubs.rs`): its cells stop splitting. Counting its triangles one
-    // by one split them to the default depth, into 44,108 leaves in 37.6 s.
+    // by one split them to the default depth, into 44,108 leaves in 37.2 s.
     let built = Built::new(&scene, PlieParams::default());
     assert!(built.octree().leaf_count() <= 64, "{} leaves", built.octree().leaf_count());
     let mut modes = ExactModes::new(&built, &scene);

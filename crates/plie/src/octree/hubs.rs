@@ -10,7 +10,7 @@
 //!   below this cell one cell per level would still hold them all, down to `max_depth`, and the
 //!   cells around it, each crossed by the hub's triangles, would split into rings at every level.
 //!   A disc of 20,000 segments around one centre (an OBJ face of 20,000 corners) made 44,108
-//!   leaves and a 296 MB P-LIE that took 37.6 s to build.
+//!   leaves and a 296 MB P-LIE that took 37.2 s to build.
 //!
 //! [`SplitCount::groups`] is the count the split rule compares with `max_triangles`: distinct
 //! triangles that touch no hub, plus one per hub. A mesh whose vertices are shared by at most
