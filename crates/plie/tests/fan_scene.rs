@@ -9,14 +9,17 @@ mod support;
 use std::f32::consts::TAU;
 
 use glam::{Vec2, Vec3};
+use plie::internals::construct::refine::{MaxBlockers, RefineParams};
 use plie::internals::lie::PlieParams;
 use plie::visibility::{LightRays, QueryCtx};
 use plie::{LightId, SceneBuilder, TriId};
 use support::{Built, ExactModes, TestRng};
 
-#[test]
-fn every_mode_matches_brute_force_over_a_fan_of_20000_triangles() {
-    let n = 20_000;
+const N: usize = 20_000;
+
+/// The disc of `N` segments, ten blades and a slab above it, and a light facing down.
+fn disc() -> plie::Scene {
+    let n = N;
     let mut b = SceneBuilder::new("disc");
     let w = b.diffuse("w", Vec3::splat(0.7));
     let rim = |i: usize| {
@@ -42,18 +45,47 @@ fn every_mode_matches_brute_force_over_a_fan_of_20000_triangles() {
     let light =
         [Vec3::new(-0.3, 1.5, -0.3), Vec3::new(0.3, 1.5, -0.3), Vec3::new(0.3, 1.5, 0.3), Vec3::new(-0.3, 1.5, 0.3)];
     b.light("l", &light, Vec3::ONE);
-    let scene = b.build().expect("a valid scene");
+    b.build().expect("a valid scene")
+}
+
+#[test]
+fn every_mode_matches_brute_force_over_a_fan_of_20000_triangles() {
+    let scene = disc();
     // The centre is a hub (`octree/hubs.rs`): its cells stop splitting. Counting its triangles one
     // by one split them to the default depth, into 44,108 leaves in 37.2 s.
     let built = Built::new(&scene, PlieParams::default());
     assert!(built.octree().leaf_count() <= 64, "{} leaves", built.octree().leaf_count());
-    let mut modes = ExactModes::new(&built, &scene);
+    check(&scene, &built, 300);
+}
+
+/// Refinement splits the hub's leaves: their children without the hub hold more triangles than the
+/// octree's limit, as their parents did. The octree stays valid and every mode exact.
+#[test]
+fn a_refined_p_lie_over_the_fan_is_valid_and_exact() {
+    let scene = disc();
+    let refine = RefineParams {
+        umbra_full: true,
+        umbra_free: true,
+        blockers: Some(MaxBlockers::Adaptive),
+        ..RefineParams::none()
+    };
+    let built = Built::refined(&scene, PlieParams { refine, ..PlieParams::default() });
+    let report = built.env.validate(&scene);
+    assert!(report.is_ok(), "{report:?}");
+    assert!(built.octree().leaf_count() > 8, "{} leaves: nothing refined", built.octree().leaf_count());
+    check(&scene, &built, 100);
+}
+
+/// `points` random points of the disc, 64 samples of the light each: every exact mode against brute
+/// force, per ray and per light.
+fn check(scene: &plie::Scene, built: &Built, points: usize) {
+    let mut modes = ExactModes::new(built, scene);
     let mut ctx = QueryCtx::new(scene.triangles.len());
     let mut rng = TestRng(5);
     let (mut rays, mut blocked) = (0, 0);
     let l = &scene.lights[0];
-    for _ in 0..300 {
-        let t = rng.below(n);
+    for _ in 0..points {
+        let t = rng.below(N);
         let (u, v) = (rng.f32(), rng.f32());
         let (u, v) = if u + v > 1.0 { (1.0 - u, 1.0 - v) } else { (u, v) };
         let x = scene.triangles[t].point(u, v);

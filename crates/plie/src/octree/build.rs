@@ -86,6 +86,7 @@ impl Octree {
             depth: 0,
             scene_triangles: n,
             capped: false,
+            built_nodes: 0,
         };
         let count = SplitCount::new(scene, params.max_triangles);
         let all = (0..n as u32).map(TriId).collect();
@@ -112,6 +113,7 @@ impl Octree {
                 .collect();
             frontier = tree.place(frontier, splits);
         }
+        tree.built_nodes = tree.nodes.len() as u32;
         tree.nodes.shrink_to_fit();
         tree.node_bounds.shrink_to_fit();
         tree.parents.shrink_to_fit();
@@ -314,6 +316,12 @@ mod tests {
             }
         }
         assert!(hub_leaves > 0);
+        // Refinement may split a hub's leaf: children without the hub may then hold more than the
+        // limit, as their parent did, and the octree is still valid.
+        let hub = o.locate(Vec3::ZERO).expect("the hub is in the octree");
+        let (refined, _) = o.split_leaves(&s, &[hub]);
+        let report = refined.validate(&s);
+        assert!(report.is_ok(), "{report}");
     }
 
     /// A unit floor (two triangles) with `copies` more copies of its first triangle (vertices in

@@ -183,6 +183,9 @@ pub struct Octree {
     /// True if the node cap ([`max_nodes`]) kept the build from splitting a level: its leaves may
     /// hold more than `max_triangles` above `max_depth`.
     pub(crate) capped: bool,
+    /// Nodes of the octree as [`Octree::build`] made it; refinement ([`refine`]) appends its nodes
+    /// after these.
+    pub(crate) built_nodes: u32,
 }
 
 /// Child `i` (bit 0: upper x, bit 1: upper y, bit 2: upper z) of the cell `b`. The split planes pass

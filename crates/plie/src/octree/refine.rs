@@ -49,6 +49,7 @@ impl Octree {
             depth: 0,
             scene_triangles: self.scene_triangles,
             capped: self.capped,
+            built_nodes: self.built_nodes,
         };
         let mut origin = Vec::with_capacity(t.leaves.capacity());
         let mut next = split.iter().peekable();

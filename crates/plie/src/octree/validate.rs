@@ -7,7 +7,8 @@
 //! - ranges: every leaf's range lies in the flat list, ranges are disjoint and cover it, triangle ids
 //!   exist and each list is strictly ascending;
 //! - size: no leaf over `max_triangles` unless at `max_depth` (or the node cap stopped the build), exact
-//!   copies and the triangles around a hub counted once as the build counts them (`hubs`);
+//!   copies and the triangles around a hub counted once as the build counts them (`hubs`), and a
+//!   leaf of refinement judged as the build's leaf it lies in;
 //! - assignment: for every triangle, the leaves it is listed in are exactly the leaves whose box grown
 //!   by `eps` it overlaps by [`triangle_overlaps_box`]. Candidates come from
 //!   [`Octree::for_each_leaf_overlapping`] on the triangle's bounding box, so the check costs about
@@ -269,16 +270,23 @@ impl Octree {
         }
     }
 
-    /// Sizes need sound ranges: called only when they are.
+    /// Sizes need sound ranges: called only when they are. A leaf that refinement made is judged as
+    /// the leaf of the build it lies in (its ancestor among the build's nodes) was: its triangles are
+    /// some of that leaf's, so they fit where that leaf's did (around a hub of that leaf's box, say).
     fn check_sizes(&self, scene: &Scene, v: &mut Vec<Violation>) {
         let mut count = None;
         for (i, leaf) in self.leaves.iter().enumerate() {
             let n = leaf.end.saturating_sub(leaf.start) as usize;
-            if n > self.params.max_triangles && leaf.depth < self.params.max_depth && !self.capped {
+            let (mut node, mut depth) = (leaf.node, leaf.depth);
+            while node >= self.built_nodes && node > 0 {
+                node = self.parents[(node as usize - 1) / 8];
+                depth -= 1;
+            }
+            if n > self.params.max_triangles && depth < self.params.max_depth && !self.capped {
                 // Copies and hubs count once (`hubs`): such a leaf is full only if the rest is.
                 let count = count.get_or_insert_with(|| SplitCount::new(scene, self.params.max_triangles));
                 let list = &self.leaf_tris[leaf.start as usize..leaf.end as usize];
-                let grown = self.node_bounds[leaf.node as usize].expanded(self.eps);
+                let grown = self.node_bounds[node as usize].expanded(self.eps);
                 if count.groups(scene, list, &grown) > self.params.max_triangles {
                     v.push(Violation::Overfull { leaf: LeafId(i as u32), triangles: n, depth: leaf.depth });
                 }
