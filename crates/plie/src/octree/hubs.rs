@@ -6,16 +6,18 @@
 //!   cells. A face line `f 1 2 3 1 2 3 ...` adding 200 copies of the Cornell box's floor triangle
 //!   made 1,220,836 leaves.
 //! - **A hub**: a vertex inside the cell's box (grown by `eps`) that more than `max_triangles`
-//!   triangles of the cell share. Every cell whose grown box holds the hub overlaps all of them, so
-//!   below this cell one cell per level would still hold them all, down to `max_depth`, and the
-//!   cells around it, each crossed by the hub's triangles, would split into rings at every level.
+//!   distinct triangles of the scene share. Every cell whose grown box holds the hub overlaps all of
+//!   them, so below this cell one cell per level would still hold them all, down to `max_depth`, and
+//!   the cells around it, each crossed by the hub's triangles, would split into rings at every level.
 //!   A disc of 20,000 segments around one centre (an OBJ face of 20,000 corners) made 44,108
 //!   leaves and a 296 MB P-LIE that took 37.2 s to build.
 //!
 //! [`SplitCount::groups`] is the count the split rule compares with `max_triangles`: distinct
 //! triangles that touch no hub, plus one per hub. A mesh whose vertices are shared by at most
-//! `max_triangles` triangles (every shared scene: at most 40 at the default 200) has no hub, so the count is its
-//! distinct triangles and its octree is what it was before hubs were counted.
+//! `max_triangles` triangles (every shared scene: at most 40, against the default 200) has no hub,
+//! so the count is its distinct triangles and its octree is what it was before hubs were counted.
+//! Which triangles a cell holds, and so every answer, never depends on this count: only where the
+//! octree stops splitting does.
 
 use rustc_hash::{FxHashMap, FxHashSet};
 
