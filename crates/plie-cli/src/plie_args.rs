@@ -22,7 +22,9 @@ pub const DEFAULT_MAX_SPLIT_DEPTH: u32 = 2;
 /// Options that set the octree and P-LIE parameters.
 #[derive(clap::Args, Clone, Debug)]
 pub struct PlieArgs {
-    /// Octree: split leaves holding more triangles than this.
+    /// Octree: split leaves holding more triangles than this. Exact copies of a triangle count once,
+    /// and so do the triangles around a vertex that more than N triangles share (splitting cannot
+    /// separate either).
     #[arg(long, default_value_t = 200, value_name = "N")]
     pub max_triangles: usize,
     /// Octree: maximum depth.

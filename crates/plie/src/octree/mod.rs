@@ -85,7 +85,9 @@ pub fn max_nodes(triangles: usize) -> usize {
 /// Octree build parameters (SPEC §3, §4.9).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 pub struct OctreeParams {
-    /// A cell with more triangles than this is split (unless at `max_depth`). Thesis default: 200.
+    /// A cell with more triangles than this is split (unless at `max_depth`), exact copies of a
+    /// triangle counted once and the triangles around a vertex that more than this many share
+    /// counted once (see `build`). Thesis default: 200.
     pub max_triangles: usize,
     /// Deepest leaf level; the root is level 0 and is always split, so leaves are at depth 1 or more.
     /// Must be in `1..=MAX_DEPTH_LIMIT`. Default: 10 (the thesis never saw depth > 8).
