@@ -48,12 +48,14 @@ pub fn root_cube(scene: &Scene, eps: f32) -> Aabb {
     Aabb::cube(scene.bounds.center(), half * (1.0 + ROOT_MARGIN) + 4.0 * eps)
 }
 
-/// A cell waiting for its split decision: its node, box, depth and triangles.
+/// A cell waiting for its split decision: its node, box, depth, triangles and the hubs in its box
+/// grown by `eps` (`hubs`).
 struct Pending {
     node: u32,
     bounds: Aabb,
     depth: u32,
     tris: Vec<TriId>,
+    hubs: Vec<u32>,
 }
 
 /// The triangle lists of the 8 children of a cell.
@@ -90,7 +92,7 @@ impl Octree {
         };
         let count = SplitCount::new(scene, params.max_triangles);
         let all = (0..n as u32).map(TriId).collect();
-        let mut frontier = vec![Pending { node: 0, bounds: root, depth: 0, tris: all }];
+        let mut frontier = vec![Pending { node: 0, bounds: root, depth: 0, tris: all, hubs: count.all_hubs() }];
         let max_nodes = super::max_nodes(n);
         while !frontier.is_empty() {
             let wants: Vec<bool> = frontier
@@ -99,7 +101,7 @@ impl Octree {
                     p.depth == 0
                         || (p.depth < params.max_depth
                             && p.tris.len() > params.max_triangles
-                            && count.groups(scene, &p.tris, &p.bounds.expanded(eps)) > params.max_triangles)
+                            && count.groups(scene, &p.tris, &p.hubs) > params.max_triangles)
                 })
                 .collect();
             // A level whose splits would pass the node cap splits nothing but the root (the same
@@ -111,7 +113,7 @@ impl Octree {
                 .zip(&wants)
                 .map(|(p, &want)| (want && (room || p.depth == 0)).then(|| split_cell(scene, &p.tris, &p.bounds, eps)))
                 .collect();
-            frontier = tree.place(frontier, splits);
+            frontier = tree.place(frontier, splits, &count);
         }
         tree.built_nodes = tree.nodes.len() as u32;
         tree.nodes.shrink_to_fit();
@@ -124,7 +126,7 @@ impl Octree {
 
     /// Places one level: split cells become inner nodes with 8 new children (returned as the next
     /// level), the others become leaves.
-    fn place(&mut self, frontier: Vec<Pending>, splits: Vec<Option<Split>>) -> Vec<Pending> {
+    fn place(&mut self, frontier: Vec<Pending>, splits: Vec<Option<Split>>, count: &SplitCount) -> Vec<Pending> {
         let mut next = Vec::new();
         for (p, split) in frontier.into_iter().zip(splits) {
             match split {
@@ -133,7 +135,8 @@ impl Octree {
                     for (i, tris) in children.into_iter().enumerate() {
                         let node = first + i as u32;
                         let bounds = self.node_bounds[node as usize];
-                        next.push(Pending { node, bounds, depth: p.depth + 1, tris });
+                        let hubs = count.hubs_in(&p.hubs, &bounds.expanded(self.eps));
+                        next.push(Pending { node, bounds, depth: p.depth + 1, tris, hubs });
                     }
                 }
                 None => self.push_leaf(p.node, p.depth, &p.tris),

@@ -12,12 +12,14 @@
 //!   A disc of 20,000 segments around one centre (an OBJ face of 20,000 corners) made 44,108
 //!   leaves and a 296 MB P-LIE that took 37.2 s to build.
 //!
-//! [`SplitCount::groups`] is the count the split rule compares with `max_triangles`: distinct
-//! triangles that touch no hub, plus one per hub. A mesh whose vertices are shared by at most
-//! `max_triangles` triangles (every shared scene: at most 40, against the default 200) has no hub,
-//! so the count is its distinct triangles and its octree is what it was before hubs were counted.
-//! Which triangles a cell holds, and so every answer, never depends on this count: only where the
-//! octree stops splitting does.
+//! [`SplitCount::groups`] is the count the split rule compares with `max_triangles`: for a cell
+//! whose grown box holds exactly one hub, the distinct triangles that do not touch it plus one;
+//! otherwise its distinct triangles. Two hubs can be separated by splitting (they are different
+//! points), so a cell with more than one still splits until each has its own. A mesh whose vertices
+//! are shared by at most `max_triangles` triangles (every shared scene: at most 40, against the
+//! default 200) has no hub, so the count is its distinct triangles and its octree is what it was
+//! before hubs were counted. Which triangles a cell holds, and so every answer, never depends on
+//! this count: only where the octree stops splitting does.
 
 use rustc_hash::{FxHashMap, FxHashSet};
 
@@ -61,21 +63,31 @@ impl SplitCount {
         tris.iter().filter(|t| self.first_copy[t.idx()]).count()
     }
 
-    /// What the split rule compares with `max_triangles` for a cell whose grown box is `grown` and
-    /// whose triangles are `tris`: distinct triangles that touch no hub inside the box, plus those
-    /// hubs (see the module doc). Without a hub in the box, [`SplitCount::distinct`].
-    pub(super) fn groups(&self, scene: &Scene, tris: &[TriId], grown: &Aabb) -> usize {
-        let inside = |k: &Key| grown.contains(glam::Vec3::from_array(k.map(f32::from_bits)));
-        let hubs: Vec<Key> = self.hubs.iter().copied().filter(inside).collect();
-        if hubs.is_empty() {
-            return self.distinct(tris);
-        }
+    /// Every hub, as indices for [`SplitCount::hubs_in`] and [`SplitCount::groups`] (none, without
+    /// allocating, in a scene without hubs).
+    pub(super) fn all_hubs(&self) -> Vec<u32> {
+        (0..self.hubs.len() as u32).collect()
+    }
+
+    /// The hubs of `among` that lie in the box `grown` (a cell's box grown by `eps`). A cell's hubs
+    /// are among its parent's, so the build filters each cell's from its parent's list.
+    pub(super) fn hubs_in(&self, among: &[u32], grown: &Aabb) -> Vec<u32> {
+        let inside = |&&h: &&u32| grown.contains(glam::Vec3::from_array(self.hubs[h as usize].map(f32::from_bits)));
+        among.iter().filter(inside).copied().collect()
+    }
+
+    /// What the split rule compares with `max_triangles` for a cell whose triangles are `tris` and
+    /// whose grown box holds the hubs `hubs` ([`SplitCount::hubs_in`]): with exactly one hub, the
+    /// distinct triangles that do not touch it, plus one; otherwise [`SplitCount::distinct`].
+    pub(super) fn groups(&self, scene: &Scene, tris: &[TriId], hubs: &[u32]) -> usize {
+        let &[hub] = hubs else { return self.distinct(tris) };
+        let hub = self.hubs[hub as usize];
         let free = tris
             .iter()
             .filter(|t| self.first_copy[t.idx()])
-            .filter(|&&t| !scene.triangle(t).v.iter().any(|&v| hubs.binary_search(&key(v)).is_ok()))
+            .filter(|&&t| !scene.triangle(t).v.iter().any(|&v| key(v) == hub))
             .count();
-        free + hubs.len()
+        free + 1
     }
 }
 
@@ -124,6 +136,12 @@ mod tests {
         (0..s.triangles.len() as u32).map(TriId).collect()
     }
 
+    /// The count of the split rule for all of `s`'s triangles in the box `grown`.
+    fn groups(s: &Scene, limit: usize, grown: &Aabb) -> usize {
+        let count = SplitCount::new(s, limit);
+        count.groups(s, &all(s), &count.hubs_in(&count.all_hubs(), grown))
+    }
+
     #[test]
     fn a_hub_counts_once_with_the_triangles_around_it() {
         let s = fan(300, 20);
@@ -131,12 +149,31 @@ mod tests {
         let around = Aabb::cube(Vec3::ZERO, 0.5);
         // 300 triangles share the centre: one hub, and the others (20 and the light's) count one each.
         let others = tris.len() - 300;
-        assert_eq!(SplitCount::new(&s, 200).groups(&s, &tris, &around), others + 1);
+        assert_eq!(groups(&s, 200, &around), others + 1);
         // A limit above the hub's 300 triangles: no hub, every triangle counts.
-        assert_eq!(SplitCount::new(&s, 300).groups(&s, &tris, &around), tris.len());
+        assert_eq!(groups(&s, 300, &around), tris.len());
         // A box that leaves the centre out: the triangles can be separated there.
         let beside = Aabb::new(Vec3::new(0.2, -0.1, 0.2), Vec3::new(0.9, 0.1, 0.9));
-        assert_eq!(SplitCount::new(&s, 200).groups(&s, &tris, &beside), tris.len());
+        assert_eq!(groups(&s, 200, &beside), tris.len());
+    }
+
+    #[test]
+    fn two_hubs_in_a_box_still_split() {
+        // Two fans of 300 triangles, one around the origin and one around (3, 0, 0).
+        let mut b = SceneBuilder::new("fans");
+        let m = b.diffuse("grey", Vec3::splat(0.5));
+        for c in [Vec3::ZERO, Vec3::X * 3.0] {
+            let rim = |i: usize| c + Vec3::new((TAU * i as f32 / 300.0).cos(), 0.0, (TAU * i as f32 / 300.0).sin());
+            for i in 0..300 {
+                b.triangle(c, rim(i + 1), rim(i), m);
+            }
+        }
+        b.light("light", &[Vec3::new(0.0, 2.0, 0.0), Vec3::new(0.1, 2.0, 0.0), Vec3::new(0.1, 2.0, 0.1)], Vec3::ONE);
+        let s = b.build().expect("valid scene");
+        let n = s.triangles.len();
+        assert_eq!(groups(&s, 200, &s.bounds.expanded(0.1)), n);
+        assert_eq!(groups(&s, 200, &Aabb::cube(Vec3::ZERO, 0.5)), n - 300 + 1);
+        assert_eq!(groups(&s, 200, &Aabb::cube(Vec3::X * 3.0, 0.5)), n - 300 + 1);
     }
 
     #[test]
@@ -156,10 +193,12 @@ mod tests {
         let tris = all(&s);
         let everything = s.bounds.expanded(1.0);
         for limit in [6, 7, 200] {
-            assert_eq!(SplitCount::new(&s, limit).groups(&s, &tris, &everything), tris.len(), "limit {limit}");
+            assert_eq!(groups(&s, limit, &everything), tris.len(), "limit {limit}");
         }
-        // Below 6 the inner vertices are hubs: the count falls.
-        assert!(SplitCount::new(&s, 5).groups(&s, &tris, &everything) < tris.len() / 2);
+        // Below 6 the inner vertices are hubs. A box holding many can still be split between
+        // them, so they do not count; a box holding one counts its 6 triangles once.
+        assert_eq!(groups(&s, 5, &everything), tris.len());
+        assert_eq!(groups(&s, 5, &Aabb::cube(Vec3::new(20.0, 0.0, 20.0), 0.5)), tris.len() - 6 + 1);
     }
 
     #[test]
@@ -175,6 +214,6 @@ mod tests {
         let tris = all(&s);
         // Five copies, another triangle and the light's.
         assert_eq!(SplitCount::new(&s, 200).distinct(&tris), 3);
-        assert_eq!(SplitCount::new(&s, 2).groups(&s, &tris, &s.bounds.expanded(1.0)), 3);
+        assert_eq!(groups(&s, 2, &s.bounds.expanded(1.0)), 3);
     }
 }

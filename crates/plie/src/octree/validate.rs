@@ -287,7 +287,8 @@ impl Octree {
                 let count = count.get_or_insert_with(|| SplitCount::new(scene, self.params.max_triangles));
                 let list = &self.leaf_tris[leaf.start as usize..leaf.end as usize];
                 let grown = self.node_bounds[node as usize].expanded(self.eps);
-                if count.groups(scene, list, &grown) > self.params.max_triangles {
+                let hubs = count.hubs_in(&count.all_hubs(), &grown);
+                if count.groups(scene, list, &hubs) > self.params.max_triangles {
                     v.push(Violation::Overfull { leaf: LeafId(i as u32), triangles: n, depth: leaf.depth });
                 }
             }
