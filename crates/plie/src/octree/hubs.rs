@@ -99,9 +99,9 @@ fn first_copies(scene: &Scene) -> Vec<bool> {
         .triangles
         .iter()
         .map(|t| {
-            let mut key = t.v.map(|v| v.to_array().map(f32::to_bits));
-            key.sort_unstable();
-            seen.insert(key)
+            let mut corners = t.v.map(key);
+            corners.sort_unstable();
+            seen.insert(corners)
         })
         .collect()
 }

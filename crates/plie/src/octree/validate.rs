@@ -284,10 +284,14 @@ impl Octree {
             }
             if n > self.params.max_triangles && depth < self.params.max_depth && !self.capped {
                 // Copies and hubs count once (`hubs`): such a leaf is full only if the rest is.
-                let count = count.get_or_insert_with(|| SplitCount::new(scene, self.params.max_triangles));
+                let (count, all) = count.get_or_insert_with(|| {
+                    let count = SplitCount::new(scene, self.params.max_triangles);
+                    let all = count.all_hubs();
+                    (count, all)
+                });
                 let list = &self.leaf_tris[leaf.start as usize..leaf.end as usize];
                 let grown = self.node_bounds[node as usize].expanded(self.eps);
-                let hubs = count.hubs_in(&count.all_hubs(), &grown);
+                let hubs = count.hubs_in(all, &grown);
                 if count.groups(scene, list, &hubs) > self.params.max_triangles {
                     v.push(Violation::Overfull { leaf: LeafId(i as u32), triangles: n, depth: leaf.depth });
                 }
