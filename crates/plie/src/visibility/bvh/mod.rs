@@ -144,9 +144,10 @@ impl Bvh {
             })
             .collect();
         let (cw, groups) = match group.then(|| group_crowded_centres(&boxes, NORMALISED_SIZE, PAD)).flatten() {
-            None => (build_cwbvh(&boxes, BvhBuildParams::medium_build()), None),
+            None => (build_cwbvh(boxes, BvhBuildParams::medium_build()), None),
             Some((prim_boxes, mut groups)) => {
-                let cw = build_cwbvh(&prim_boxes, BvhBuildParams::medium_build());
+                drop(boxes);
+                let cw = build_cwbvh(prim_boxes, BvhBuildParams::medium_build());
                 groups.place(&cw.primitive_indices);
                 (cw, Some(groups))
             }
@@ -324,21 +325,29 @@ fn segment_occluded_with<S: FastStack<UVec2>, P: Prims>(
 /// obvhs' `build_cwbvh` (PLOC, reinsertion, conversion to BVH8) without its debug-build `validate`,
 /// which asserts that the depth fits obvhs' fixed stack: here a deeper BVH is valid ([`Walk`]). Where
 /// PLOC would stall ([`top_down::ploc_would_stall`]), a top-down build takes its place.
-fn build_cwbvh(boxes: &[BAabb], config: BvhBuildParams) -> CwBvh {
-    let mut bvh2 = if top_down::ploc_would_stall(boxes) {
-        top_down::build(boxes)
+///
+/// The boxes are dropped once the binary BVH holds them, before the conversion, which is the build's
+/// peak of memory; the BVH8's arrays keep only what they hold (obvhs reserves a node per primitive).
+fn build_cwbvh(boxes: Vec<BAabb>, config: BvhBuildParams) -> CwBvh {
+    let mut bvh2 = if top_down::ploc_would_stall(&boxes) {
+        top_down::build(&boxes)
     } else {
         let indices = (0..boxes.len() as u32).collect::<Vec<_>>();
         PlocBuilder::with_capacity(boxes.len()).build(
             config.ploc_search_distance,
-            boxes,
+            &boxes,
             indices,
             config.sort_precision,
             config.search_depth_threshold,
         )
     };
+    drop(boxes);
     ReinsertionOptimizer::default().run(&mut bvh2, config.reinsertion_batch_ratio, None);
-    bvh2_to_cwbvh(&bvh2, config.max_prims_per_leaf.clamp(1, 3), true, false)
+    let mut cw = bvh2_to_cwbvh(&bvh2, config.max_prims_per_leaf.clamp(1, 3), true, false);
+    drop(bvh2);
+    cw.nodes.shrink_to_fit();
+    cw.primitive_indices.shrink_to_fit();
+    cw
 }
 
 /// Depth of the deepest inner node of `cw` (the root is 0; 0 for an empty BVH). The inner children of
@@ -598,7 +607,7 @@ mod tests {
     #[test]
     fn depth_of_an_empty_and_a_one_box_bvh() {
         assert_eq!(inner_depth(&CwBvh::default()), 0);
-        let one = build_cwbvh(&[BAabb::new(Vec3A::ZERO, Vec3A::ONE)], BvhBuildParams::medium_build());
+        let one = build_cwbvh(vec![BAabb::new(Vec3A::ZERO, Vec3A::ONE)], BvhBuildParams::medium_build());
         assert_eq!(inner_depth(&one), 0);
     }
 }
