@@ -118,7 +118,7 @@ pub(super) fn flatten(
         stats.blockers.candidates_clipped += t.candidates;
         stats.regions.records_removed_umbra += t.removed_umbra;
         task_seconds += t.seconds;
-        computed += t.computed.iter().flatten().count();
+        computed += usize::from(t.computed);
     }
     stats.propagation.record_seconds_mean = if computed > 0 { task_seconds / computed as f64 } else { 0.0 };
     let (mut umbra_sum, mut penumbra_sum) = (0.0, 0.0);

@@ -128,12 +128,12 @@ pub(super) fn lift_caps(
                         let old = slot.records[face.index()].as_mut().expect("a capped record");
                         old.liftable = false;
                         if r.kind == RecordKind::Scene {
-                            *old = PendingRecord { liftable: false, ..r };
+                            **old = PendingRecord { liftable: false, ..r };
                         }
                     }
                     Some(r) => {
                         used += r.list_bytes();
-                        slot.records[face.index()] = Some(r);
+                        slot.records[face.index()] = Some(Box::new(r));
                         lift.lifted += 1;
                     }
                     // Its full regions show the face in umbra: removed (§4.6), as without the cap.
@@ -142,7 +142,6 @@ pub(super) fn lift_caps(
                         debug_assert!(matches!(fo.state, FaceState::Dark { .. }));
                         round.states.set(leaf, face, light, fo.state);
                         slot.records[face.index()] = None;
-                        slot.computed[face.index()] = Some(fo.state);
                         slot.removed_umbra += 1;
                         lift.lifted += 1;
                     }
@@ -168,7 +167,7 @@ pub(super) fn in_lift_order(
     let mut out: Vec<(usize, Dir)> = Vec::new();
     for (t, task) in round.tasks.iter().enumerate() {
         for f in Dir::ALL {
-            if task.records[f.index()].as_ref().is_some_and(&keep) {
+            if task.records[f.index()].as_deref().is_some_and(&keep) {
                 out.push((t, f));
             }
         }

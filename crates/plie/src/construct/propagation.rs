@@ -66,6 +66,7 @@ pub mod principle;
 pub mod rules;
 pub mod state;
 
+use rayon::slice::ParallelSliceMut;
 use std::collections::VecDeque;
 
 pub use principle::{Exit, LightHull, Source};
@@ -113,19 +114,20 @@ pub struct Propagated {
 /// by leaf then light.
 pub fn task_order(scene: &Scene, octree: &Octree, propagate: bool) -> Vec<(LeafId, LightId)> {
     let lights = scene.lights.len() as u32;
-    let mut tasks: Vec<(LeafId, LightId)> =
-        octree.leaves().flat_map(|l| (0..lights).map(move |i| (l, LightId(i)))).collect();
-    if propagate {
-        let dist =
-            |&(l, i): &(LeafId, LightId)| octree.leaf_bounds(l).center().distance(scene.lights[i.idx()].center());
-        tasks.sort_by(|a, b| dist(a).total_cmp(&dist(b)).then(a.cmp(b)));
+    let tasks = octree.leaves().flat_map(|l| (0..lights).map(move |i| (l, LightId(i))));
+    if !propagate {
+        return tasks.collect();
     }
-    tasks
+    // Each distance computed once; a distance is not negative, so its bits order as it does, and the
+    // keys are distinct, so an unstable sort gives the one order.
+    let dist = |l: LeafId, i: LightId| octree.leaf_bounds(l).center().distance(scene.lights[i.idx()].center());
+    let mut keyed: Vec<(u32, LeafId, LightId)> = tasks.map(|(l, i)| (dist(l, i).to_bits(), l, i)).collect();
+    keyed.par_sort_unstable();
+    keyed.into_iter().map(|(_, l, i)| (l, i)).collect()
 }
 
 /// Runs the rules from source cells until nothing changes, recording what it deletes.
 pub struct Propagator<'a> {
-    scene: &'a Scene,
     octree: &'a Octree,
     t: Tolerances,
     hulls: Vec<LightHull<'a>>,
@@ -142,7 +144,6 @@ impl<'a> Propagator<'a> {
     /// A propagator for `scene` over `octree`.
     pub fn new(scene: &'a Scene, octree: &'a Octree, t: Tolerances) -> Propagator<'a> {
         Propagator {
-            scene,
             octree,
             t,
             hulls: scene.lights.iter().map(|l| LightHull::new(l, &t)).collect(),
@@ -154,17 +155,12 @@ impl<'a> Propagator<'a> {
         }
     }
 
-    /// After the commit of some (leaf, light) tasks: propagates from each that has a face known dark,
-    /// light by light in task order.
-    pub fn after_commit(&mut self, states: &mut FaceStates, tasks: &[(LeafId, LightId)]) {
-        for light in 0..self.scene.lights.len() as u32 {
-            let light = LightId(light);
-            let sources: Vec<NodeId> = tasks
-                .iter()
-                .filter(|&&(l, i)| i == light && Dir::ALL.iter().any(|&f| states.get(l, f, light).vouches().is_some()))
-                .map(|&(l, _)| self.octree.leaf_node(l))
-                .collect();
-            self.run(states, light, &sources);
+    /// After the commit of the (leaf, light) task: propagates for that light from the leaf if one of
+    /// its faces is known dark. Only the task's light: the cost of a commit does not grow with the
+    /// scene's lights.
+    pub fn after_commit(&mut self, states: &mut FaceStates, leaf: LeafId, light: LightId) {
+        if Dir::ALL.iter().any(|&f| states.get(leaf, f, light).vouches().is_some()) {
+            self.run(states, light, &[self.octree.leaf_node(leaf)]);
         }
     }
 

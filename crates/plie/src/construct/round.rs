@@ -16,15 +16,20 @@ use crate::octree::{Dir, LeafId, Octree};
 use crate::progress::Progress;
 use crate::scene::{LightId, Scene};
 
-/// What was computed for one (leaf, light): a record per face, the faces' new states, counters.
+/// What was computed for one (leaf, light): a record per face, counters. There is one per (leaf,
+/// light), most without a record (a face that cannot see the light), so the records are boxed: with
+/// many lights the build's memory is that of the records it keeps, not of the (leaf, light) pairs.
 #[derive(Default)]
 pub(super) struct TaskRecords {
-    pub(super) records: [Option<PendingRecord>; 6],
-    pub(super) computed: [Option<FaceState>; 6],
+    pub(super) records: [Option<Box<PendingRecord>>; 6],
+    /// Faces whose record was computed (kept or removed in umbra).
+    pub(super) computed: u8,
     pub(super) candidates: usize,
     pub(super) removed_umbra: usize,
     pub(super) seconds: f64,
 }
+// One per (leaf, light): kept small whatever a record holds.
+const _: () = assert!(std::mem::size_of::<TaskRecords>() <= 80);
 
 /// What one round computed: every (leaf, light) task's records, every face's state, and what
 /// propagation did.
@@ -55,7 +60,7 @@ impl Round {
 /// Bytes the blocker lists of `tasks`' records take ([`PendingRecord::list_bytes`]): what the memory
 /// budget has spent on them.
 pub(super) fn list_bytes(tasks: &[TaskRecords]) -> usize {
-    tasks.iter().flat_map(|t| t.records.iter().flatten()).map(PendingRecord::list_bytes).sum()
+    tasks.iter().flat_map(|t| t.records.iter().flatten()).map(|r| r.list_bytes()).sum()
 }
 
 /// The previous round and, for each leaf of the refined octree, the leaf of the previous one it is
@@ -104,10 +109,11 @@ pub(super) fn run_round(
         propagator.log =
             propagator_log.iter().filter_map(|p| new_of[p.leaf.idx()].map(|leaf| Propagated { leaf, ..*p })).collect();
     }
-    let initial = states.clone();
-    // Set at the commit that deletes a face: workers skip it (a face deleted later is computed anyway,
-    // and its result discarded at its own commit).
-    let deleted: Vec<AtomicBool> = (0..states.len()).map(|_| AtomicBool::new(false)).collect();
+    // Set where a face is pending at the start and cleared at the commit that deletes it: workers skip
+    // a face whose flag is clear (a face deleted later is computed anyway, and its result discarded at
+    // its own commit). One byte per (leaf, face, light), where a copy of the states took sixteen.
+    let todo: Vec<AtomicBool> =
+        (0..states.len()).map(|i| AtomicBool::new(states.at(i) == FaceState::Pending)).collect();
     // The budget counts the lists of the records carried over from the previous round too.
     let used = list_bytes(&tasks);
     let budget = Budget { limit: limits.list_bytes, used, over: 0, grids: params.has_grids() };
@@ -127,16 +133,16 @@ pub(super) fn run_round(
             }
             let out: [Option<FaceOut>; 6] = std::array::from_fn(|f| {
                 let face = Dir::from_index(f);
-                let pending = initial.get(leaf, face, light) == FaceState::Pending;
-                let todo = pending && !deleted[initial.index(leaf, face, light)].load(Ordering::Acquire);
+                let todo = todo[FaceStates::index_of(lights, leaf, face, light)].load(Ordering::Acquire);
                 todo.then(|| face_record(scene, octree, (leaf, light), face, &tols, abs_scale, params, scratch))
             });
             progress.advance(1);
-            Some(out)
+            // Boxed, and only where a face was computed: the schedule holds a slot per task.
+            Some(out.iter().any(Option::is_some).then(|| Box::new(out)))
         },
         |k, out| {
             if let Some(out) = out {
-                commits.commit(order[k], out, &deleted);
+                commits.commit(order[k], out.map_or_else(|| std::array::from_fn(|_| None), |o| *o), &todo);
             }
         },
     );
@@ -187,14 +193,9 @@ pub(super) struct Commits<'a> {
 
 impl Commits<'_> {
     /// Commits one task: each face's outcome (computed, or deleted by an earlier commit), then
-    /// propagation from the task's leaf (stage 6); what it deletes is marked in `deleted` for the
+    /// propagation from the task's leaf (stage 6); what it deletes is cleared in `todo` for the
     /// workers.
-    pub(super) fn commit(
-        &mut self,
-        (leaf, light): (LeafId, LightId),
-        out: [Option<FaceOut>; 6],
-        deleted: &[AtomicBool],
-    ) {
+    pub(super) fn commit(&mut self, (leaf, light): (LeafId, LightId), out: [Option<FaceOut>; 6], todo: &[AtomicBool]) {
         let t = &mut self.tasks[leaf.idx() * self.lights + light.idx()];
         for (face, fo) in Dir::ALL.into_iter().zip(out) {
             match self.states.get(leaf, face, light) {
@@ -207,8 +208,8 @@ impl Commits<'_> {
             }
             let fo = fo.expect("a face pending at its task's commit was computed");
             self.states.set(leaf, face, light, fo.state);
-            t.records[face.index()] = fo.record.map(|r| self.budget.spend(r));
-            t.computed[face.index()] = Some(fo.state);
+            t.records[face.index()] = fo.record.map(|r| Box::new(self.budget.spend(r)));
+            t.computed += 1;
             t.candidates += fo.candidates;
             t.removed_umbra += matches!(fo.state, FaceState::Dark { .. }) as usize;
             t.seconds += fo.seconds;
@@ -216,9 +217,9 @@ impl Commits<'_> {
         if self.propagate {
             let t0 = Instant::now();
             let before = self.propagator.log.len();
-            self.propagator.after_commit(&mut self.states, &[(leaf, light)]);
+            self.propagator.after_commit(&mut self.states, leaf, light);
             for d in &self.propagator.log[before..] {
-                deleted[self.states.index(d.leaf, d.face, d.light)].store(true, Ordering::Release);
+                todo[self.states.index(d.leaf, d.face, d.light)].store(false, Ordering::Release);
             }
             self.seconds += t0.elapsed().as_secs_f64();
         }

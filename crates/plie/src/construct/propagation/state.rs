@@ -75,7 +75,13 @@ impl FaceStates {
     /// The index of (leaf, face, light), `0..len()`.
     #[inline]
     pub fn index(&self, leaf: LeafId, face: Dir, light: LightId) -> usize {
-        (leaf.idx() * 6 + face.index()) * self.lights + light.idx()
+        FaceStates::index_of(self.lights, leaf, face, light)
+    }
+
+    /// The index of (leaf, face, light) among `lights` lights ([`FaceStates::index`]).
+    #[inline]
+    pub fn index_of(lights: usize, leaf: LeafId, face: Dir, light: LightId) -> usize {
+        (leaf.idx() * 6 + face.index()) * lights + light.idx()
     }
 
     /// Number of (leaf, face, light).
@@ -92,6 +98,12 @@ impl FaceStates {
     #[inline]
     pub fn get(&self, leaf: LeafId, face: Dir, light: LightId) -> FaceState {
         self.states[self.index(leaf, face, light)]
+    }
+
+    /// The state at index `i` ([`FaceStates::index`]).
+    #[inline]
+    pub fn at(&self, i: usize) -> FaceState {
+        self.states[i]
     }
 
     /// Sets the state of (leaf, face, light).
