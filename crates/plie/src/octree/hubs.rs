@@ -21,7 +21,11 @@
 //! before hubs were counted. Which triangles a cell holds, and so every answer, never depends on
 //! this count: only where the octree stops splitting does.
 
-use rustc_hash::{FxHashMap, FxHashSet};
+use std::hash::BuildHasher;
+use std::sync::atomic::{AtomicU32, Ordering};
+
+use rayon::prelude::*;
+use rustc_hash::FxBuildHasher;
 
 use crate::geometry::Aabb;
 use crate::scene::{Scene, TriId};
@@ -46,15 +50,7 @@ impl SplitCount {
     /// Counts for `scene` at the split limit `max_triangles`.
     pub(super) fn new(scene: &Scene, max_triangles: usize) -> SplitCount {
         let first_copy = first_copies(scene);
-        let mut valence: FxHashMap<Key, u32> = FxHashMap::default();
-        for (t, _) in scene.triangles.iter().zip(&first_copy).filter(|(_, &first)| first) {
-            for v in t.v {
-                *valence.entry(key(v)).or_insert(0) += 1;
-            }
-        }
-        let mut hubs: Vec<Key> =
-            valence.into_iter().filter(|&(_, n)| n as usize > max_triangles).map(|(k, _)| k).collect();
-        hubs.sort_unstable();
+        let hubs = hub_vertices(scene, &first_copy, max_triangles);
         SplitCount { first_copy, hubs }
     }
 
@@ -93,17 +89,58 @@ impl SplitCount {
 
 /// For every triangle, whether it is the first of its exact copies (the same vertices, in any order,
 /// compared bit for bit). Copies overlap the same cells, so a cell holding a copy holds its first.
+///
+/// In parallel, by sorting: the triangles sorted by a hash of their sorted corners, then by index, so
+/// that copies are neighbours; a run of equal hashes is sorted again by the corners themselves (two
+/// triangles may share a hash without being copies), and in each group of equal corners all but the
+/// first index are copies.
 fn first_copies(scene: &Scene) -> Vec<bool> {
-    let mut seen = FxHashSet::with_capacity_and_hasher(scene.triangles.len(), Default::default());
-    scene
-        .triangles
-        .iter()
-        .map(|t| {
-            let mut corners = t.v.map(key);
-            corners.sort_unstable();
-            seen.insert(corners)
-        })
-        .collect()
+    let corners = |t: TriId| {
+        let mut c = scene.triangle(t).v.map(key);
+        c.sort_unstable();
+        c
+    };
+    let mut keyed: Vec<(u64, u32)> = (0..scene.triangles.len() as u32)
+        .into_par_iter()
+        .map(|t| (FxBuildHasher.hash_one(corners(TriId(t))), t))
+        .collect();
+    keyed.par_sort_unstable();
+    let mut first = vec![true; scene.triangles.len()];
+    let mut run = Vec::new();
+    for same_hash in keyed.chunk_by(|a, b| a.0 == b.0).filter(|r| r.len() > 1) {
+        run.clear();
+        run.extend(same_hash.iter().map(|&(_, t)| (corners(TriId(t)), t)));
+        run.sort_unstable();
+        for copies in run.chunk_by(|a, b| a.0 == b.0) {
+            for &(_, t) in &copies[1..] {
+                first[t as usize] = false;
+            }
+        }
+    }
+    first
+}
+
+/// The vertices that more than `max_triangles` distinct triangles (the first of their copies) share,
+/// ascending.
+///
+/// In parallel: each corner adds one to a counter chosen by its vertex's hash, so a counter bounds
+/// the number of triangles around each vertex hashed to it. Only vertices whose counter passes the
+/// limit can be hubs; their corners are gathered and counted exactly, by sorting. In a mesh without
+/// hubs almost none are.
+fn hub_vertices(scene: &Scene, first_copy: &[bool], max_triangles: usize) -> Vec<Key> {
+    // About one counter per corner, at most 2^24 (64 MiB).
+    let bits = (3 * scene.triangles.len()).next_power_of_two().trailing_zeros().clamp(10, 24);
+    let counter = |k: &Key| (FxBuildHasher.hash_one(k) >> (64 - bits)) as usize;
+    let counts: Vec<AtomicU32> = (0..1usize << bits).map(|_| AtomicU32::new(0)).collect();
+    let corners =
+        || scene.triangles.par_iter().zip(first_copy).filter(|(_, &first)| first).flat_map_iter(|(t, _)| t.v.map(key));
+    corners().for_each(|k| {
+        counts[counter(&k)].fetch_add(1, Ordering::Relaxed);
+    });
+    let limit = u32::try_from(max_triangles).unwrap_or(u32::MAX);
+    let mut maybe: Vec<Key> = corners().filter(|k| counts[counter(k)].load(Ordering::Relaxed) > limit).collect();
+    maybe.par_sort_unstable();
+    maybe.chunk_by(|a, b| a == b).filter(|run| run.len() > max_triangles).map(|run| run[0]).collect()
 }
 
 #[cfg(test)]
@@ -215,5 +252,58 @@ mod tests {
         // Five copies, another triangle and the light's.
         assert_eq!(SplitCount::new(&s, 200).distinct(&tris), 3);
         assert_eq!(groups(&s, 2, &s.bounds.expanded(1.0)), 3);
+    }
+
+    /// The parallel counts equal the plain ones (a hash set of sorted corners, a map of valences) on a
+    /// mesh of shared vertices with copies in any corner order, fans of several sizes, and at limits
+    /// from 0 up, so that the counters' filter passes from almost every vertex to none.
+    #[test]
+    fn parallel_counts_equal_plain_ones() {
+        use std::collections::{HashMap, HashSet};
+        let mut b = SceneBuilder::new("mesh");
+        let m = b.diffuse("grey", Vec3::splat(0.5));
+        let p = |i: usize, j: usize| Vec3::new(i as f32, ((i * 7 + j * 3) % 5) as f32 * 0.1, j as f32);
+        for i in 0..12 {
+            for j in 0..12 {
+                b.triangle(p(i, j), p(i + 1, j), p(i + 1, j + 1), m);
+                b.triangle(p(i, j), p(i + 1, j + 1), p(i, j + 1), m);
+                if (i + j) % 5 == 0 {
+                    b.triangle(p(i + 1, j + 1), p(i, j), p(i + 1, j), m);
+                }
+            }
+        }
+        for (k, n) in [3usize, 9, 40].into_iter().enumerate() {
+            let c = Vec3::new(30.0 + 5.0 * k as f32, 0.0, 0.0);
+            let rim =
+                |i: usize| c + Vec3::new((TAU * i as f32 / n as f32).cos(), 0.0, (TAU * i as f32 / n as f32).sin());
+            for i in 0..n {
+                b.triangle(c, rim(i + 1), rim(i), m);
+            }
+        }
+        b.light("light", &[Vec3::new(0.0, 9.0, 0.0), Vec3::new(0.1, 9.0, 0.0), Vec3::new(0.1, 9.0, 0.1)], Vec3::ONE);
+        let s = b.build().expect("valid scene");
+        let mut seen = HashSet::new();
+        let plain_first: Vec<bool> = s
+            .triangles
+            .iter()
+            .map(|t| {
+                let mut c = t.v.map(key);
+                c.sort_unstable();
+                seen.insert(c)
+            })
+            .collect();
+        assert_eq!(first_copies(&s), plain_first);
+        assert!(plain_first.iter().any(|&f| !f), "the mesh has copies");
+        let mut valence: HashMap<Key, usize> = HashMap::new();
+        for (t, _) in s.triangles.iter().zip(&plain_first).filter(|(_, &f)| f) {
+            for v in t.v {
+                *valence.entry(key(v)).or_insert(0) += 1;
+            }
+        }
+        for limit in [0, 1, 2, 3, 5, 6, 8, 9, 39, 40, 200] {
+            let mut plain: Vec<Key> = valence.iter().filter(|&(_, &n)| n > limit).map(|(&k, _)| k).collect();
+            plain.sort_unstable();
+            assert_eq!(hub_vertices(&s, &plain_first, limit), plain, "limit {limit}");
+        }
     }
 }
