@@ -125,20 +125,37 @@ fn first_copies(scene: &Scene) -> Vec<bool> {
 ///
 /// In parallel: each corner adds one to a counter chosen by its vertex's hash, so a counter bounds
 /// the number of triangles around each vertex hashed to it. Only vertices whose counter passes the
-/// limit can be hubs; their corners are gathered and counted exactly, by sorting. In a mesh without
-/// hubs almost none are.
+/// limit can be hubs; the counters that pass it are noted as they do (in a mesh without hubs, none
+/// is, and the count ends there), and the corners hashed to them are gathered and counted exactly,
+/// by sorting. The table holds about one counter per four corners, at most 2^22 (16 MiB), so that it
+/// stays in cache: at the default limit of 200 a false alarm needs some 30 vertices in one counter.
 fn hub_vertices(scene: &Scene, first_copy: &[bool], max_triangles: usize) -> Vec<Key> {
-    // About one counter per corner, at most 2^24 (64 MiB).
-    let bits = (3 * scene.triangles.len()).next_power_of_two().trailing_zeros().clamp(10, 24);
+    let bits = (3 * scene.triangles.len()).next_power_of_two().trailing_zeros().saturating_sub(2).clamp(10, 22);
     let counter = |k: &Key| (FxBuildHasher.hash_one(k) >> (64 - bits)) as usize;
     let counts: Vec<AtomicU32> = (0..1usize << bits).map(|_| AtomicU32::new(0)).collect();
     let corners =
         || scene.triangles.par_iter().zip(first_copy).filter(|(_, &first)| first).flat_map_iter(|(t, _)| t.v.map(key));
-    corners().for_each(|k| {
-        counts[counter(&k)].fetch_add(1, Ordering::Relaxed);
-    });
     let limit = u32::try_from(max_triangles).unwrap_or(u32::MAX);
-    let mut maybe: Vec<Key> = corners().filter(|k| counts[counter(k)].load(Ordering::Relaxed) > limit).collect();
+    // A counter passes the limit once: at the corner that takes it from `limit` to `limit + 1`.
+    let passed: Vec<usize> = corners()
+        .filter_map(|k| {
+            let c = counter(&k);
+            (counts[c].fetch_add(1, Ordering::Relaxed) == limit).then_some(c)
+        })
+        .collect();
+    if passed.is_empty() {
+        return Vec::new();
+    }
+    let mut over = vec![0u64; (1usize << bits).div_ceil(64)];
+    for c in passed {
+        over[c / 64] |= 1 << (c % 64);
+    }
+    let mut maybe: Vec<Key> = corners()
+        .filter(|k| {
+            let c = counter(k);
+            over[c / 64] & (1 << (c % 64)) != 0
+        })
+        .collect();
     maybe.par_sort_unstable();
     maybe.chunk_by(|a, b| a == b).filter(|run| run.len() > max_triangles).map(|run| run[0]).collect()
 }
