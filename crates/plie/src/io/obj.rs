@@ -130,19 +130,35 @@ struct ObjRules<'a> {
     mesh_only: bool,
     /// The line of every triangle `tobj` will produce, in order.
     tri_lines: Vec<u32>,
+    /// Scratch of [`ObjRules::face`]: each corner's vertex and texture index.
+    corners: Vec<(u64, Option<u64>)>,
 }
 
 impl<'a> ObjRules<'a> {
     fn new(libs: &'a RefCell<Libraries>) -> Self {
-        ObjRules { libs, vertices: 0, texcoords: 0, normals: 0, mesh_only: false, tri_lines: Vec::new() }
+        ObjRules {
+            libs,
+            vertices: 0,
+            texcoords: 0,
+            normals: 0,
+            mesh_only: false,
+            tri_lines: Vec::new(),
+            corners: Vec::new(),
+        }
     }
 
     fn vertex(&mut self, words: SplitWhitespace, out: &mut String) -> Result<(), String> {
         self.vertices += 1;
         let n = self.vertices;
-        let tokens: Vec<&str> = words.take(8).collect();
+        let (mut tokens, mut count) = ([""; 7], 0);
+        for word in words.take(8) {
+            if let Some(slot) = tokens.get_mut(count) {
+                *slot = word;
+            }
+            count += 1;
+        }
         let what = || format!("vertex {n}");
-        match tokens.len() {
+        match count {
             3 | 6 => {
                 out.push('v');
                 for t in &tokens[..3] {
@@ -200,8 +216,9 @@ impl<'a> ObjRules<'a> {
                 i => Err(format!("{what} index {i} out of range: {n} {plural} are defined before this line")),
             }
         };
-        let mut corners: Vec<(u64, Option<u64>)> = Vec::new();
-        for token in words {
+        let corners = &mut self.corners;
+        corners.clear();
+        for token in words.clone() {
             let mut parts = token.split('/');
             let absolute = resolve(parts.next().unwrap_or(""), v, token)?;
             let uv = match parts.next() {
@@ -217,14 +234,13 @@ impl<'a> ObjRules<'a> {
         // Texture indices only when every corner has one, so tobj's arrays stay parallel.
         let with_uv = corners.iter().all(|c| c.1.is_some());
         out.push('f');
-        for (p, uv) in &corners {
-            match uv {
-                Some(uv) if with_uv => {
-                    let _ = write!(out, " {p}/{uv}");
-                }
-                _ => {
-                    let _ = write!(out, " {p}");
-                }
+        for (token, &(p, uv)) in words.zip(corners.iter()) {
+            let mut parts = token.split('/');
+            out.push(' ');
+            push_index(out, parts.next().unwrap_or(""), p);
+            if let (Some(uv), true) = (uv, with_uv) {
+                out.push('/');
+                push_index(out, parts.next().unwrap_or(""), uv);
             }
         }
         let k = corners.len();
@@ -249,6 +265,16 @@ impl<'a> ObjRules<'a> {
         }
         let _ = write!(out, "usemtl {name}");
         Ok(())
+    }
+}
+
+/// Writes the index `value` that the face token's part `text` resolved to: the text itself when it is
+/// plain digits (it reads as `value`, as `tobj` would read it), else the number (a relative index).
+fn push_index(out: &mut String, text: &str, value: u64) {
+    if !text.is_empty() && text.bytes().all(|b| b.is_ascii_digit()) {
+        out.push_str(text);
+    } else {
+        let _ = write!(out, "{value}");
     }
 }
 

@@ -172,6 +172,9 @@ impl<R: BufRead, L: LineRules> BufRead for LineFilter<R, L> {
 
 /// The line without its comment: everything from a `#` that starts a word.
 pub(super) fn strip_comment(line: &str) -> &str {
+    if !line.as_bytes().contains(&b'#') {
+        return line;
+    }
     let mut prev_space = true;
     for (i, ch) in line.char_indices() {
         if ch == '#' && prev_space {
